@@ -1,0 +1,12 @@
+//! Geometry in `f64`: polygons (triangles and quads), boxes and quadrature rules.
+
+mod aabb;
+mod polygon;
+pub mod quadrature;
+
+pub use aabb::Aabb;
+pub use glam::DVec3;
+pub use polygon::{Poly, PolyKind};
+
+/// Relative tolerance under which a length is treated as zero, relative to the size of the object it belongs to.
+pub const REL_EPS: f64 = 1e-12;

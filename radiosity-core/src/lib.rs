@@ -1,0 +1,14 @@
+//! Hierarchical radiosity with clustering, refinement oracles and visibility by ray casting.
+//!
+//! The data flows one way, one module per step:
+//! - [`scene`]: load and validate OBJ / MGF / the embedded Cornell box → [`scene::Scene`]
+//! - [`hierarchy`]: clusters over the input polygons, surfaces subdivided lazily → [`hierarchy::Hierarchy`]
+//! - [`formfactor`]: point-to-polygon analytic form factors, receiver quadrature, isotropic clusters
+//! - [`visibility`]: ray casting against a BVH of the input triangles
+//! - [`refine`]: the oracle decides per link: link here or subdivide → links
+//! - [`solve`]: gather, push-pull, GMRES on the hierarchical operator → radiosity per element
+//! - [`output`]: `image.png`, `solution.ply`, `patches.csv`, `stats.json`
+#![warn(missing_docs)]
+
+pub mod geom;
+pub mod scene;

@@ -1,0 +1,200 @@
+//! Step 1, `scene`: load and validate a scene (OBJ + MTL, MGF, or the embedded Cornell box) into a
+//! flat list of planar triangles and quads with materials.
+
+mod builder;
+mod cornell;
+mod error;
+pub mod mgf;
+mod obj;
+
+pub use builder::SceneBuilder;
+pub use cornell::cornell_box;
+pub use error::SceneError;
+
+use crate::geom::{Aabb, DVec3, Poly};
+use std::path::Path;
+
+/// A diffuse material. Radiometric quantities are per RGB channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name from the scene file.
+    pub name: String,
+    /// Diffuse reflectance ρ in [0, 1).
+    pub reflectance: [f64; 3],
+    /// Emitted radiosity (exitance) E in W/m².
+    pub emission: [f64; 3],
+    /// Diffuse transmittance (two-sided surfaces only).
+    pub transmittance: [f64; 3],
+    /// Whether both sides of the surface interact with light.
+    pub two_sided: bool,
+}
+
+impl Material {
+    /// A grey, non-emitting, one-sided material.
+    #[must_use]
+    pub fn diffuse(name: &str, reflectance: [f64; 3]) -> Material {
+        Material { name: name.to_owned(), reflectance, emission: [0.0; 3], transmittance: [0.0; 3], two_sided: false }
+    }
+
+    /// True when some channel emits.
+    #[must_use]
+    pub fn is_emitter(&self) -> bool {
+        self.emission.iter().any(|&e| e > 0.0)
+    }
+}
+
+/// One input polygon (after triangulation of polygons with more than 4 vertices).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Polygon {
+    /// Geometry, CCW about the front normal.
+    pub poly: Poly,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Index into [`Scene::groups`].
+    pub group: u32,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// Viewing direction (unit).
+    pub direction: DVec3,
+    /// Up vector (unit, roughly orthogonal to `direction`).
+    pub up: DVec3,
+    /// Vertical field of view in radians.
+    pub fov_y: f64,
+}
+
+impl Camera {
+    /// A camera that sees the whole box from its front (-z side... toward +z is away): placed on the
+    /// +z side looking down -z, with a 40° field of view, y up.
+    #[must_use]
+    pub fn looking_at_box(bounds: &Aabb) -> Camera {
+        let c = bounds.center();
+        let e = bounds.extent();
+        let fov_y = 40f64.to_radians();
+        let half = 0.5 * e.x.max(e.y).max(1e-300);
+        let dist = half / (0.5 * fov_y).tan() + 0.5 * e.z;
+        Camera { position: c + DVec3::Z * dist * 1.05, direction: -DVec3::Z, up: DVec3::Y, fov_y }
+    }
+}
+
+/// Counts of input problems that were repaired or skipped rather than rejected.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct SceneWarnings {
+    /// Faces skipped because their area is zero (or below the relative tolerance).
+    pub degenerate_faces: usize,
+    /// Faces with more than 4 vertices, or non-planar / non-convex quads, that were triangulated.
+    pub triangulated_faces: usize,
+    /// Materials whose reflectance was clamped below 1 (formats whose total reflectance may reach 1).
+    pub clamped_materials: usize,
+    /// The first few warnings in words (file:line: reason).
+    pub messages: Vec<String>,
+}
+
+/// A validated scene: planar, non-degenerate triangles and quads with finite coordinates.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Display name (file name or `cornell-box`).
+    pub name: String,
+    /// Input polygons in input order.
+    pub polygons: Vec<Polygon>,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Object / group names.
+    pub groups: Vec<String>,
+    /// The scene's camera, when it has one.
+    pub camera: Option<Camera>,
+    /// What was repaired or skipped.
+    pub warnings: SceneWarnings,
+}
+
+/// Options of [`load`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LoadOptions {
+    /// Accept a scene with no emitter.
+    pub allow_dark: bool,
+}
+
+/// Loads an OBJ (+ MTL) or MGF file, chosen by extension, and validates it.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let scene = match ext.as_deref() {
+        Some("obj") => obj::load(path)?,
+        Some("mgf") => mgf::load(path)?,
+        _ => {
+            if !path.exists() {
+                return Err(SceneError::Io {
+                    path: path.to_owned(),
+                    source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+                });
+            }
+            return Err(SceneError::UnknownFormat { path: path.to_owned() });
+        }
+    };
+    scene.check(path, options)?;
+    Ok(scene)
+}
+
+impl Scene {
+    /// Validation common to every format: non-empty, at least one emitter unless `allow_dark`.
+    pub fn check(&self, path: &Path, options: &LoadOptions) -> Result<(), SceneError> {
+        if self.polygons.is_empty() {
+            return Err(SceneError::Empty { path: path.to_owned() });
+        }
+        if !options.allow_dark && !self.polygons.iter().any(|p| self.materials[p.material as usize].is_emitter()) {
+            return Err(SceneError::NoEmitter { path: path.to_owned() });
+        }
+        Ok(())
+    }
+
+    /// Bounding box of all polygons.
+    #[must_use]
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for p in &self.polygons {
+            for &v in p.poly.vertices() {
+                b.grow(v);
+            }
+        }
+        b
+    }
+
+    /// Total area of all polygons.
+    #[must_use]
+    pub fn total_area(&self) -> f64 {
+        self.polygons.iter().map(|p| p.poly.area()).sum()
+    }
+
+    /// Material of polygon `i`.
+    #[must_use]
+    pub fn material_of(&self, i: usize) -> &Material {
+        &self.materials[self.polygons[i].material as usize]
+    }
+
+    /// The camera, or one framing the scene's bounding box.
+    #[must_use]
+    pub fn camera_or_default(&self) -> Camera {
+        self.camera.unwrap_or_else(|| Camera::looking_at_box(&self.bounds()))
+    }
+
+    /// Applies `f` to every vertex (used to build scaled / translated test scenes).
+    pub fn transform(&mut self, f: impl Fn(DVec3) -> DVec3) {
+        for p in &mut self.polygons {
+            for v in &mut p.poly.v {
+                *v = f(*v);
+            }
+        }
+        if let Some(c) = &mut self.camera {
+            let pos = f(c.position);
+            let ahead = f(c.position + c.direction);
+            let d = (ahead - pos).normalize_or_zero();
+            if d != DVec3::ZERO {
+                c.direction = d;
+            }
+            c.position = pos;
+        }
+    }
+}
