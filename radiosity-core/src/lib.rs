@@ -12,3 +12,10 @@
 
 pub mod geom;
 pub mod scene;
+pub mod formfactor;
+pub mod hierarchy;
+pub mod visibility;
+pub mod refine;
+pub mod solve;
+pub mod pipeline;
+pub mod output;

@@ -6,6 +6,7 @@ mod cornell;
 mod error;
 pub mod mgf;
 mod obj;
+pub mod shapes;
 
 pub use builder::SceneBuilder;
 pub use cornell::cornell_box;

@@ -1,0 +1,122 @@
+//! Top-down cluster construction over the input polygons (median split of centroids along the
+//! longest axis of their bounds).
+
+use super::{Element, ElementId, ElementKind, Hierarchy, NONE, surface_element};
+use crate::geom::{Aabb, DVec3};
+use crate::scene::Scene;
+
+/// How the hierarchy is built.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildConfig {
+    /// Most polygons directly under one cluster.
+    pub max_leaf_polygons: usize,
+    /// Smallest surface element area, relative to the scene's total area.
+    pub min_area_rel: f64,
+}
+
+impl Default for BuildConfig {
+    fn default() -> Self {
+        BuildConfig { max_leaf_polygons: 4, min_area_rel: 2e-6 }
+    }
+}
+
+/// Builds the hierarchy of `scene`: one root surface element per polygon (ids `0..n`), then clusters.
+#[must_use]
+pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
+    let n = scene.polygons.len();
+    let mut elements = Vec::with_capacity(2 * n + 1);
+    for (i, p) in scene.polygons.iter().enumerate() {
+        elements.push(surface_element(i as u32, p.poly, p.poly.normal(), NONE, 0));
+    }
+    let reflectance = scene.polygons.iter().map(|p| scene.materials[p.material as usize].reflectance).collect();
+    let emission = scene.polygons.iter().map(|p| scene.materials[p.material as usize].emission).collect();
+    let total_area: f64 = elements.iter().map(|e| e.area).sum();
+    let mut h = Hierarchy {
+        elements,
+        children: Vec::with_capacity(2 * n),
+        cluster_polygons: (0..n as u32).collect(),
+        cluster_area_prefix: Vec::new(),
+        root: NONE,
+        n_polygons: n as u32,
+        reflectance,
+        emission,
+        min_area: config.min_area_rel * total_area,
+    };
+    let centroids: Vec<DVec3> = h.elements.iter().map(|e| e.center).collect();
+    h.root = build_cluster(&mut h, &centroids, 0, n, 0, config.max_leaf_polygons.max(2));
+    let mut prefix = Vec::with_capacity(n + 1);
+    let mut acc = 0.0;
+    prefix.push(0.0);
+    for &p in &h.cluster_polygons {
+        acc += h.elements[p as usize].area;
+        prefix.push(acc);
+    }
+    h.cluster_area_prefix = prefix;
+    h
+}
+
+fn build_cluster(h: &mut Hierarchy, centroids: &[DVec3], start: usize, end: usize, depth: u16, max_leaf: usize) -> ElementId {
+    let id = h.elements.len() as ElementId;
+    // Reserve the slot; children are filled in below.
+    h.elements.push(Element {
+        kind: ElementKind::Cluster { poly_start: start as u32, poly_end: end as u32 },
+        parent: NONE,
+        child_start: 0,
+        n_children: 0,
+        area: 0.0,
+        center: DVec3::ZERO,
+        normal: DVec3::ZERO,
+        bounds: Aabb::EMPTY,
+        radius: 0.0,
+        depth,
+    });
+    let kids: Vec<ElementId> = if end - start <= max_leaf {
+        h.cluster_polygons[start..end].to_vec()
+    } else {
+        let mut cb = Aabb::EMPTY;
+        for &p in &h.cluster_polygons[start..end] {
+            cb.grow(centroids[p as usize]);
+        }
+        let axis = cb.longest_axis();
+        let mid = (start + end) / 2;
+        h.cluster_polygons[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b))
+        });
+        vec![
+            build_cluster(h, centroids, start, mid, depth + 1, max_leaf),
+            build_cluster(h, centroids, mid, end, depth + 1, max_leaf),
+        ]
+    };
+    let child_start = h.children.len() as u32;
+    let mut bounds = Aabb::EMPTY;
+    let mut area = 0.0;
+    let mut weighted = DVec3::ZERO;
+    for &k in &kids {
+        let e = &mut h.elements[k as usize];
+        e.parent = id;
+        bounds.merge(&e.bounds);
+        area += e.area;
+        weighted += e.area * e.center;
+        h.children.push(k);
+    }
+    let center = if area > 0.0 { weighted / area } else { bounds.center() };
+    // Bounding sphere about the area centroid: farthest box corner.
+    let radius = (0..8)
+        .map(|c| {
+            let corner = DVec3::new(
+                if c & 1 == 0 { bounds.min.x } else { bounds.max.x },
+                if c & 2 == 0 { bounds.min.y } else { bounds.max.y },
+                if c & 4 == 0 { bounds.min.z } else { bounds.max.z },
+            );
+            (corner - center).length()
+        })
+        .fold(0.0, f64::max);
+    let e = &mut h.elements[id as usize];
+    e.child_start = child_start;
+    e.n_children = kids.len() as u32;
+    e.bounds = bounds;
+    e.area = area;
+    e.center = center;
+    e.radius = radius;
+    id
+}

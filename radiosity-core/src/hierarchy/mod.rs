@@ -1,0 +1,260 @@
+//! Step 2, `hierarchy`: an arena of elements addressed by `u32` ids. Clusters are built top-down over
+//! the input polygons; each polygon is the root of a surface hierarchy subdivided lazily and regularly
+//! (triangles and quads into 4).
+//!
+//! Architecture invariant: element `i < n_polygons` is the root surface element of input polygon `i`;
+//! the root cluster is [`Hierarchy::root`]. Ids never change once given; children of an element are
+//! created together and are contiguous in [`Hierarchy::children`].
+
+mod build;
+
+pub use build::{BuildConfig, build};
+
+use crate::geom::{Aabb, DVec3, Poly};
+
+/// Index of an element in the arena.
+pub type ElementId = u32;
+
+/// "No element".
+pub const NONE: ElementId = u32::MAX;
+
+/// What an element is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ElementKind {
+    /// A piece of input polygon `polygon` (the whole polygon at depth 0).
+    Surface {
+        /// Input polygon index.
+        polygon: u32,
+        /// The piece's geometry.
+        poly: Poly,
+    },
+    /// A group of elements; `polys` is its range in [`Hierarchy::cluster_polygons`].
+    Cluster {
+        /// First index into `cluster_polygons`.
+        poly_start: u32,
+        /// One past the last index.
+        poly_end: u32,
+    },
+}
+
+/// One node of the hierarchy.
+#[derive(Clone, Debug)]
+pub struct Element {
+    /// Surface piece or cluster.
+    pub kind: ElementKind,
+    /// Parent, or [`NONE`] for the root cluster and (before clustering) polygon roots.
+    pub parent: ElementId,
+    /// Start of the children in [`Hierarchy::children`].
+    pub child_start: u32,
+    /// Number of children (0 for a leaf).
+    pub n_children: u32,
+    /// Surface area (sum of the surfaces' areas for a cluster), scene units².
+    pub area: f64,
+    /// Area centroid.
+    pub center: DVec3,
+    /// Unit front normal (zero for clusters).
+    pub normal: DVec3,
+    /// Bounding box.
+    pub bounds: Aabb,
+    /// Radius of a sphere about `center` containing the element.
+    pub radius: f64,
+    /// Depth below its polygon root (surfaces) or below the root cluster (clusters).
+    pub depth: u16,
+}
+
+impl Element {
+    /// True for clusters.
+    #[must_use]
+    pub fn is_cluster(&self) -> bool {
+        matches!(self.kind, ElementKind::Cluster { .. })
+    }
+
+    /// The surface geometry, if a surface.
+    #[must_use]
+    pub fn poly(&self) -> Option<&Poly> {
+        match &self.kind {
+            ElementKind::Surface { poly, .. } => Some(poly),
+            ElementKind::Cluster { .. } => None,
+        }
+    }
+
+    /// The input polygon of a surface element.
+    #[must_use]
+    pub fn polygon(&self) -> Option<u32> {
+        match self.kind {
+            ElementKind::Surface { polygon, .. } => Some(polygon),
+            ElementKind::Cluster { .. } => None,
+        }
+    }
+}
+
+/// The element arena plus per-polygon radiometric constants.
+#[derive(Clone, Debug)]
+pub struct Hierarchy {
+    /// All elements; see the module's invariant.
+    pub elements: Vec<Element>,
+    /// Children lists, indexed by `child_start .. child_start + n_children`.
+    pub children: Vec<ElementId>,
+    /// Input polygon indices in cluster order (each cluster covers a contiguous range).
+    pub cluster_polygons: Vec<u32>,
+    /// Prefix sums of polygon areas in `cluster_polygons` order (length + 1), for area sampling.
+    pub cluster_area_prefix: Vec<f64>,
+    /// Root cluster.
+    pub root: ElementId,
+    /// Number of input polygons.
+    pub n_polygons: u32,
+    /// Reflectance per input polygon.
+    pub reflectance: Vec<[f64; 3]>,
+    /// Emission (W/m²) per input polygon.
+    pub emission: Vec<[f64; 3]>,
+    /// Smallest area a surface element may be subdivided into.
+    pub min_area: f64,
+}
+
+impl Hierarchy {
+    /// The element `id`.
+    #[must_use]
+    #[inline]
+    pub fn get(&self, id: ElementId) -> &Element {
+        &self.elements[id as usize]
+    }
+
+    /// Children of `id`.
+    #[must_use]
+    #[inline]
+    pub fn children_of(&self, id: ElementId) -> &[ElementId] {
+        let e = &self.elements[id as usize];
+        &self.children[e.child_start as usize..(e.child_start + e.n_children) as usize]
+    }
+
+    /// Number of elements.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.elements.len()
+    }
+
+    /// True when there is no element.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.elements.is_empty()
+    }
+
+    /// Whether `id` can be subdivided: clusters always (they have children), surfaces while their
+    /// children would not fall below `min_area`.
+    #[must_use]
+    pub fn can_subdivide(&self, id: ElementId) -> bool {
+        let e = self.get(id);
+        e.n_children > 0 || (!e.is_cluster() && e.area * 0.25 >= self.min_area)
+    }
+
+    /// Creates the 4 children of surface `id` if it has none yet (lazy regular subdivision).
+    /// Returns false when `id` cannot be subdivided.
+    pub fn subdivide(&mut self, id: ElementId) -> bool {
+        let e = &self.elements[id as usize];
+        if e.n_children > 0 {
+            return true;
+        }
+        let ElementKind::Surface { polygon, poly } = e.kind else {
+            return false;
+        };
+        if e.area * 0.25 < self.min_area {
+            return false;
+        }
+        let depth = e.depth + 1;
+        let normal = e.normal;
+        let child_start = self.children.len() as u32;
+        for child in poly.subdivide() {
+            let cid = self.elements.len() as ElementId;
+            self.elements.push(surface_element(polygon, child, normal, id, depth));
+            self.children.push(cid);
+        }
+        let e = &mut self.elements[id as usize];
+        e.child_start = child_start;
+        e.n_children = 4;
+        true
+    }
+
+    /// Leaves (elements without children), in id order.
+    pub fn leaves(&self) -> impl Iterator<Item = ElementId> + '_ {
+        (0..self.elements.len() as ElementId).filter(|&i| self.elements[i as usize].n_children == 0)
+    }
+
+    /// Reflectance of a surface element's polygon; the area-weighted mean for a cluster.
+    #[must_use]
+    pub fn reflectance_of(&self, id: ElementId) -> [f64; 3] {
+        match self.get(id).kind {
+            ElementKind::Surface { polygon, .. } => self.reflectance[polygon as usize],
+            ElementKind::Cluster { poly_start, poly_end } => {
+                let mut acc = [0.0; 3];
+                let mut area = 0.0;
+                for &p in &self.cluster_polygons[poly_start as usize..poly_end as usize] {
+                    let a = self.get(p).area;
+                    for c in 0..3 {
+                        acc[c] += a * self.reflectance[p as usize][c];
+                    }
+                    area += a;
+                }
+                acc.map(|x| if area > 0.0 { x / area } else { 0.0 })
+            }
+        }
+    }
+
+    /// Finds the leaf of polygon `polygon` containing the parameter point `(s, t)`, and the
+    /// parameters in that leaf.
+    #[must_use]
+    pub fn locate(&self, polygon: u32, mut s: f64, mut t: f64) -> (ElementId, f64, f64) {
+        let mut id = polygon;
+        loop {
+            let e = self.get(id);
+            if e.n_children == 0 {
+                return (id, s, t);
+            }
+            let ElementKind::Surface { poly, .. } = e.kind else { return (id, s, t) };
+            let (c, s2, t2) = Poly::child_of_param(poly.kind, s, t);
+            id = self.children_of(id)[c];
+            s = s2;
+            t = t2;
+        }
+    }
+
+    /// Picks a point on the surfaces of `id` from two uniform numbers in [0, 1) plus a third for
+    /// choosing the polygon of a cluster (by area). Returns the point and its input polygon.
+    #[must_use]
+    pub fn sample_point(&self, id: ElementId, u: f64, v: f64, w: f64) -> (DVec3, u32) {
+        match self.get(id).kind {
+            ElementKind::Surface { polygon, poly } => (poly.sample(u, v), polygon),
+            ElementKind::Cluster { poly_start, poly_end } => {
+                let (a, b) = (poly_start as usize, poly_end as usize);
+                let lo = self.cluster_area_prefix[a];
+                let hi = self.cluster_area_prefix[b];
+                let target = lo + w * (hi - lo);
+                // Binary search for the polygon whose prefix interval holds `target`.
+                let k = match self.cluster_area_prefix[a..=b].partition_point(|&x| x <= target) {
+                    0 => a,
+                    k => (a + k - 1).min(b - 1),
+                };
+                let p = self.cluster_polygons[k];
+                let ElementKind::Surface { poly, .. } = self.get(p).kind else { unreachable!("cluster polygons are surfaces") };
+                (poly.sample(u, v), p)
+            }
+        }
+    }
+}
+
+fn surface_element(polygon: u32, poly: Poly, normal: DVec3, parent: ElementId, depth: u16) -> Element {
+    let center = poly.centroid();
+    let bounds = Aabb::from_points(poly.vertices());
+    let radius = poly.vertices().iter().map(|v| (*v - center).length()).fold(0.0, f64::max);
+    Element {
+        kind: ElementKind::Surface { polygon, poly },
+        parent,
+        child_start: 0,
+        n_children: 0,
+        area: poly.area(),
+        center,
+        normal,
+        bounds,
+        radius,
+        depth,
+    }
+}

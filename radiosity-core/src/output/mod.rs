@@ -1,0 +1,14 @@
+//! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `solution.ply`, `patches.csv`,
+//! `stats.json` (names and columns are relied on by other tools: see DESIGN.md).
+
+mod csv;
+mod ply;
+mod render;
+mod smooth;
+mod stats;
+
+pub use csv::{PolygonResult, polygon_results, write_patches_csv};
+pub use ply::write_ply;
+pub use render::{RenderConfig, ToneMap, render, write_png};
+pub use smooth::CornerValues;
+pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};

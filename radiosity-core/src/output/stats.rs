@@ -1,0 +1,99 @@
+//! `stats.json` and the figures it holds.
+
+use crate::hierarchy::Hierarchy;
+use crate::solve::Solution;
+
+/// Seconds per phase, as written in `stats.json` under `time_s`.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct StatsTimes {
+    /// Loading and validating the scene.
+    pub load: f64,
+    /// Building clusters and the BVH.
+    pub build: f64,
+    /// Refinement.
+    pub refine: f64,
+    /// Linear solves.
+    pub solve: f64,
+    /// Writing outputs.
+    pub output: f64,
+    /// Everything.
+    pub total: f64,
+}
+
+/// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Stats {
+    /// Scene name.
+    pub scene: String,
+    /// Oracle name.
+    pub oracle: String,
+    /// Oracle and solver parameters.
+    pub params: serde_json::Value,
+    /// Input polygons.
+    pub polygons: usize,
+    /// Elements (clusters and surfaces).
+    pub elements: usize,
+    /// Leaf elements.
+    pub leaves: usize,
+    /// Links.
+    pub links: usize,
+    /// Visibility rays cast.
+    pub rays: u64,
+    /// Precise form factors computed.
+    pub form_factors: u64,
+    /// Operator applications over all passes.
+    pub iterations: usize,
+    /// Refine → solve rounds.
+    pub passes: usize,
+    /// Final relative residual of the linear system.
+    pub residual: f64,
+    /// A-posteriori error estimate of the solution (null until estimated).
+    pub error_estimate: Option<f64>,
+    /// Seconds per phase.
+    pub time_s: StatsTimes,
+    /// Peak resident memory of the process (bytes), when the platform reports it.
+    pub peak_rss_bytes: Option<u64>,
+    /// Machinery left out for this scene.
+    pub left_out: Vec<String>,
+    /// Area-weighted mean radiosity of the leaves [r, g, b] (W/m²).
+    pub radiosity_mean: [f64; 3],
+    /// Emitted power Σ A·E (W, summed over channels divided by 3).
+    pub power_emitted: f64,
+    /// Absorbed power Σ A·(1−ρ)·H (W, same channel mean).
+    pub power_absorbed: f64,
+    /// Input warnings (degenerate faces skipped, etc.).
+    pub warnings: crate::scene::SceneWarnings,
+}
+
+/// Peak resident set size of this process (`VmHWM` on Linux).
+#[must_use]
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// `(emitted, absorbed, mean radiosity)`: emitted and absorbed power per channel mean, and the
+/// area-weighted mean leaf radiosity.
+#[must_use]
+pub fn power_balance(h: &Hierarchy, solution: &Solution) -> (f64, f64, [f64; 3]) {
+    let mut emitted = 0.0;
+    let mut absorbed = 0.0;
+    let mut mean = [0.0; 3];
+    let mut area = 0.0;
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        let Some(p) = e.polygon() else { continue };
+        let (rho, em) = (h.reflectance[p as usize], h.emission[p as usize]);
+        let hh = solution.irradiance[leaf as usize];
+        let b = solution.radiosity[leaf as usize];
+        for c in 0..3 {
+            emitted += e.area * em[c] / 3.0;
+            absorbed += e.area * (1.0 - rho[c]) * hh[c] / 3.0;
+            mean[c] += e.area * b[c];
+        }
+        area += e.area;
+    }
+    (emitted, absorbed, mean.map(|m| if area > 0.0 { m / area } else { 0.0 }))
+}

@@ -1,0 +1,189 @@
+//! The whole solve, step after step: hierarchy → (refine → solve)* → a [`Solved`] result with the
+//! figures `stats.json` reports. Front ends (the CLI, tests, benchmarks) call [`run`].
+
+use crate::hierarchy::{self, BuildConfig, Hierarchy};
+use crate::refine::{self, Link, Oracle, RefineStats};
+use crate::scene::Scene;
+use crate::solve::{self, Solution, SolveConfig};
+use crate::visibility::{RayCaster, VisibilityConfig};
+use std::time::Instant;
+
+/// Settings of a full solve.
+#[derive(Clone, Copy, Debug)]
+pub struct Config {
+    /// Hierarchy construction.
+    pub build: BuildConfig,
+    /// Visibility sampling.
+    pub visibility: VisibilityConfig,
+    /// Linear solver.
+    pub solve: SolveConfig,
+    /// Most refine → solve rounds (refinement stops earlier when a round subdivides nothing).
+    pub max_passes: usize,
+    /// Cast rays for visibility (false: every link is taken as fully visible).
+    pub use_visibility: bool,
+    /// Re-gather every leaf from its chain of links at leaf resolution after the last solve.
+    pub final_gather: bool,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            build: BuildConfig::default(),
+            visibility: VisibilityConfig::default(),
+            solve: SolveConfig::default(),
+            max_passes: 3,
+            use_visibility: true,
+            final_gather: true,
+        }
+    }
+}
+
+/// Seconds spent per phase.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct Timings {
+    /// Building clusters and the ray-casting BVH.
+    pub build: f64,
+    /// Refinement (oracle calls, form factors, visibility).
+    pub refine: f64,
+    /// Linear solves.
+    pub solve: f64,
+}
+
+/// Progress events for front ends.
+#[derive(Clone, Copy, Debug)]
+pub enum Progress {
+    /// Refinement pass `pass`: `links` kept so far, `pending` candidates.
+    Refine {
+        /// Pass number from 1.
+        pass: usize,
+        /// Links so far.
+        links: u64,
+        /// Candidates waiting.
+        pending: u64,
+    },
+    /// A solve finished.
+    Solved {
+        /// Pass number from 1.
+        pass: usize,
+        /// Operator applications.
+        iterations: usize,
+        /// Relative residual.
+        residual: f64,
+    },
+}
+
+/// The result of [`run`].
+pub struct Solved {
+    /// The element hierarchy.
+    pub hierarchy: Hierarchy,
+    /// Final links.
+    pub links: Vec<Link>,
+    /// Final solution.
+    pub solution: Solution,
+    /// Ray caster (for rendering), when visibility was used or requested.
+    pub caster: RayCaster,
+    /// Refinement counters summed over passes.
+    pub refine_stats: RefineStats,
+    /// Rays cast during refinement.
+    pub rays: u64,
+    /// Refine → solve rounds done.
+    pub passes: usize,
+    /// Operator applications summed over passes.
+    pub iterations: usize,
+    /// Time per phase.
+    pub timings: Timings,
+}
+
+/// Solves `scene` with `oracle`.
+pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn Fn(Progress)) -> Solved {
+    let t0 = Instant::now();
+    let mut h = hierarchy::build(scene, &config.build);
+    let caster = RayCaster::new(scene);
+    let mut timings = Timings { build: t0.elapsed().as_secs_f64(), ..Timings::default() };
+
+    let b_ref = h.emission.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let mut radiosity = initial_radiosity(&h);
+    let mut links = Vec::new();
+    let mut stats = RefineStats::default();
+    let mut solution = None;
+    let mut passes = 0;
+    let mut iterations = 0;
+    for pass in 1..=config.max_passes.max(1) {
+        let t = Instant::now();
+        let (new_links, s) = refine::refine(
+            &mut h,
+            config.use_visibility.then_some(&caster),
+            config.visibility,
+            oracle,
+            links,
+            &mut radiosity,
+            b_ref,
+            &|l, p| progress(Progress::Refine { pass, links: l, pending: p }),
+        );
+        links = new_links;
+        timings.refine += t.elapsed().as_secs_f64();
+        stats.oracle_calls += s.oracle_calls;
+        stats.form_factors += s.form_factors;
+        stats.subdivided += s.subdivided;
+        stats.dropped += s.dropped;
+        stats.links = s.links;
+        passes = pass;
+        if pass > 1 && s.subdivided == 0 {
+            break;
+        }
+        let t = Instant::now();
+        let sol = solve::solve(&h, &links, &radiosity, &config.solve);
+        timings.solve += t.elapsed().as_secs_f64();
+        iterations += sol.iterations;
+        progress(Progress::Solved { pass, iterations: sol.iterations, residual: sol.residual });
+        radiosity.clone_from(&sol.radiosity);
+        solution = Some(sol);
+    }
+    let mut solution = solution.expect("at least one pass solves");
+    if config.final_gather {
+        let t = Instant::now();
+        let (b, irr) = solve::final_gather(&h, &links, &solution.radiosity);
+        solution.radiosity = b;
+        solution.irradiance = irr;
+        timings.solve += t.elapsed().as_secs_f64();
+    }
+    let rays = caster.rays_cast();
+    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, iterations, timings }
+}
+
+/// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene
+/// estimate `Φ / (A (1 − ρ̄))`), reflected by each polygon.
+fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
+    let n = h.n_polygons as usize;
+    let mut power = [0.0; 3];
+    let mut area = 0.0;
+    let mut rho_area = [0.0; 3];
+    for p in 0..n {
+        let a = h.get(p as u32).area;
+        area += a;
+        for c in 0..3 {
+            power[c] += a * h.emission[p][c];
+            rho_area[c] += a * h.reflectance[p][c];
+        }
+    }
+    let ambient: [f64; 3] = std::array::from_fn(|c| if area > 0.0 { power[c] / area / (1.0 - rho_area[c] / area).max(1e-3) } else { 0.0 });
+    let mut b = vec![[0.0; 3]; h.len()];
+    for p in 0..n {
+        b[p] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * ambient[c]);
+    }
+    // Clusters: area-weighted means, children before parents (clusters were created after their children).
+    for e in n..h.len() {
+        let el = h.get(e as u32);
+        if el.is_cluster() {
+            let mut acc = [0.0; 3];
+            for &k in h.children_of(e as u32) {
+                let a = h.get(k).area;
+                for c in 0..3 {
+                    acc[c] += a * b[k as usize][c];
+                }
+            }
+            b[e] = acc.map(|v| if el.area > 0.0 { v / el.area } else { 0.0 });
+        }
+    }
+    b
+}

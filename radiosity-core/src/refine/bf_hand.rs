@@ -1,0 +1,66 @@
+//! The classic BF refinement oracle (Hanrahan, Salzman & Aupperle 1991), written by hand as a plain
+//! function: the baseline generated oracles are compared against.
+
+use super::{Decision, LinkCtx, Oracle};
+
+/// Parameters of the BF oracle.
+#[derive(Clone, Copy, Debug)]
+pub struct BfParams {
+    /// Threshold on `B_S · F`, relative to the scene's largest emitted radiosity.
+    pub eps: f64,
+}
+
+impl Default for BfParams {
+    fn default() -> Self {
+        BfParams { eps: 0.01 }
+    }
+}
+
+/// The hand-written BF oracle.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BfHand {
+    /// Its parameters.
+    pub params: BfParams,
+}
+
+impl Oracle for BfHand {
+    fn name(&self) -> &str {
+        "bf-hand"
+    }
+
+    fn decide(&self, ctx: &mut LinkCtx<'_>) -> Decision {
+        bf_decide(ctx, &self.params)
+    }
+}
+
+/// The BF decision: drop pairs that cannot see each other's front; link when `B_S · F_max` (the
+/// largest point form factor over the receiver, estimated) is below
+/// `eps · B_ref`; otherwise subdivide the larger element (by bounding radius), or the other one when
+/// the larger cannot be subdivided, or link when neither can.
+pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
+    if !ctx.facing() {
+        return Decision::Stop;
+    }
+    let f = ctx.form_factor_max();
+    let b = ctx.emitter_radiosity();
+    let (s, r) = (ctx.emitter_element(), ctx.receiver_element());
+    // Clusters must be well separated for the isotropic approximation to hold.
+    let near_cluster = (s.is_cluster() || r.is_cluster()) && (s.center - r.center).length() < 2.0 * (s.radius + r.radius);
+    if !near_cluster && b * f <= params.eps * ctx.services.b_ref {
+        return Decision::Link;
+    }
+    let h = ctx.hierarchy();
+    let (can_s, can_r) = (h.can_subdivide(ctx.emitter), h.can_subdivide(ctx.receiver));
+    match (can_s, can_r) {
+        (false, false) => Decision::Link,
+        (true, false) => Decision::SubdivideEmitter,
+        (false, true) => Decision::SubdivideReceiver,
+        (true, true) => {
+            if s.radius >= r.radius {
+                Decision::SubdivideEmitter
+            } else {
+                Decision::SubdivideReceiver
+            }
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! The refinement driver: evaluates candidate links in parallel batches, then applies the decisions
+//! serially (creating children lazily), so the result does not depend on the number of threads.
+
+use super::{Decision, LinkCtx, Oracle, Services};
+use crate::formfactor::FormFactorQuality;
+use crate::hierarchy::{ElementId, Hierarchy};
+use crate::visibility::{RayCaster, VisibilityConfig};
+use rayon::prelude::*;
+
+/// Form factors at or below this are dropped rather than stored as links.
+pub const MIN_LINK_FORM_FACTOR: f64 = 0.0;
+
+/// A link: light from `source` gathered by `receiver` with coefficient `ff · vis`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Link {
+    /// Emitter element.
+    pub source: ElementId,
+    /// Receiver element (links are stored with their receiver).
+    pub receiver: ElementId,
+    /// Form factor coefficient (see [`crate::formfactor`]).
+    pub ff: f64,
+    /// Visibility fraction in [0, 1].
+    pub vis: f64,
+}
+
+/// Counters of one refinement run.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct RefineStats {
+    /// Oracle calls.
+    pub oracle_calls: u64,
+    /// Links kept.
+    pub links: u64,
+    /// Precise form factors computed.
+    pub form_factors: u64,
+    /// Links subdivided.
+    pub subdivided: u64,
+    /// Links dropped by the oracle or for a zero form factor.
+    pub dropped: u64,
+}
+
+#[derive(Clone, Copy)]
+struct Candidate {
+    source: ElementId,
+    receiver: ElementId,
+    /// Form factor and visibility of an existing link being re-examined.
+    existing: Option<(f64, f64)>,
+}
+
+enum Outcome {
+    Keep(Link, bool),
+    Split(Decision),
+    Drop,
+}
+
+/// Refines `links` (or, when empty, the root self-link) with `oracle` until every candidate is linked
+/// or dropped. `radiosity` holds the current radiosity per element; it is extended for new elements
+/// (children inherit their parent's value). `progress` is called after each batch with
+/// (links so far, candidates pending).
+#[allow(clippy::too_many_arguments)]
+pub fn refine(
+    h: &mut Hierarchy,
+    caster: Option<&RayCaster>,
+    visibility: VisibilityConfig,
+    oracle: &dyn Oracle,
+    links: Vec<Link>,
+    radiosity: &mut Vec<[f64; 3]>,
+    b_ref: f64,
+    progress: &dyn Fn(u64, u64),
+) -> (Vec<Link>, RefineStats) {
+    let mut stats = RefineStats::default();
+    let mut pending: Vec<Candidate> = if links.is_empty() {
+        vec![Candidate { source: h.root, receiver: h.root, existing: None }]
+    } else {
+        links.iter().map(|l| Candidate { source: l.source, receiver: l.receiver, existing: Some((l.ff, l.vis)) }).collect()
+    };
+    let mut out = Vec::with_capacity(links.len().max(1024));
+    while !pending.is_empty() {
+        let outcomes: Vec<Outcome> = {
+            let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref };
+            pending.par_iter().map(|c| evaluate(&services, oracle, c)).collect()
+        };
+        let mut next = Vec::new();
+        for (c, outcome) in pending.iter().zip(outcomes) {
+            match outcome {
+                Outcome::Keep(link, computed) => {
+                    stats.oracle_calls += u64::from(c.source != c.receiver);
+                    stats.form_factors += u64::from(computed);
+                    if link.ff * link.vis > MIN_LINK_FORM_FACTOR || c.existing.is_some() {
+                        out.push(link);
+                    } else {
+                        stats.dropped += 1;
+                    }
+                }
+                Outcome::Drop => {
+                    stats.oracle_calls += u64::from(c.source != c.receiver);
+                    stats.dropped += 1;
+                }
+                Outcome::Split(d) => {
+                    stats.oracle_calls += u64::from(c.source != c.receiver);
+                    stats.subdivided += 1;
+                    split(h, radiosity, c, d, &mut next);
+                }
+            }
+        }
+        pending = next;
+        progress(out.len() as u64, pending.len() as u64);
+    }
+    stats.links = out.len() as u64;
+    (out, stats)
+}
+
+fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outcome {
+    let h = services.hierarchy;
+    if c.source == c.receiver {
+        // Self-links: a cluster interacts with itself through its children; a planar surface does not.
+        return if h.get(c.source).is_cluster() { Outcome::Split(Decision::SubdivideBoth) } else { Outcome::Drop };
+    }
+    let mut ctx = LinkCtx::new(services, c.source, c.receiver);
+    match oracle.decide(&mut ctx) {
+        Decision::Link => {
+            if let Some((ff, vis)) = c.existing {
+                return Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, false);
+            }
+            let ff = ctx.form_factor(FormFactorQuality::Precise);
+            let vis = if ff > 0.0 { ctx.visibility(services.visibility.rays) } else { 0.0 };
+            Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, true)
+        }
+        Decision::Stop => Outcome::Drop,
+        d @ (Decision::SubdivideEmitter | Decision::SubdivideReceiver | Decision::SubdivideBoth) => {
+            // An oracle may ask for an impossible subdivision: fall back to what can be done.
+            let can_s = h.can_subdivide(c.source);
+            let can_r = h.can_subdivide(c.receiver);
+            let d = match (d, can_s, can_r) {
+                (_, false, false) => {
+                    let ff = ctx.form_factor(FormFactorQuality::Precise);
+                    let vis = if ff > 0.0 { ctx.visibility(services.visibility.rays) } else { 0.0 };
+                    return Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, true);
+                }
+                (Decision::SubdivideEmitter, false, true) | (Decision::SubdivideBoth, false, true) => Decision::SubdivideReceiver,
+                (Decision::SubdivideReceiver, true, false) | (Decision::SubdivideBoth, true, false) => Decision::SubdivideEmitter,
+                (d, _, _) => d,
+            };
+            Outcome::Split(d)
+        }
+    }
+}
+
+fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, c: &Candidate, d: Decision, next: &mut Vec<Candidate>) {
+    let mut children_of = |h: &mut Hierarchy, id: ElementId| -> Vec<ElementId> {
+        if h.get(id).n_children == 0 {
+            h.subdivide(id);
+            let b = radiosity[id as usize];
+            radiosity.resize(h.len(), [0.0; 3]);
+            for &k in h.children_of(id) {
+                radiosity[k as usize] = b;
+            }
+        }
+        h.children_of(id).to_vec()
+    };
+    match d {
+        Decision::SubdivideEmitter => {
+            for s in children_of(h, c.source) {
+                next.push(Candidate { source: s, receiver: c.receiver, existing: None });
+            }
+        }
+        Decision::SubdivideReceiver => {
+            for r in children_of(h, c.receiver) {
+                next.push(Candidate { source: c.source, receiver: r, existing: None });
+            }
+        }
+        Decision::SubdivideBoth => {
+            let ss = children_of(h, c.source);
+            let rs = if c.receiver == c.source { ss.clone() } else { children_of(h, c.receiver) };
+            for &r in &rs {
+                for &s in &ss {
+                    next.push(Candidate { source: s, receiver: r, existing: None });
+                }
+            }
+        }
+        Decision::Link | Decision::Stop => unreachable!("split is only called for subdivisions"),
+    }
+}

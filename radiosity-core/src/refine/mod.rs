@@ -1,0 +1,35 @@
+//! Step 3, `refine`: the oracle decides for every link (emitter → receiver) whether to link here or
+//! subdivide; the driver applies the decisions, subdividing elements lazily, until every candidate
+//! is linked or dropped.
+
+mod bf_hand;
+mod context;
+mod driver;
+
+pub use bf_hand::{BfHand, BfParams};
+pub use context::{LinkCtx, LinkData, Services};
+pub use driver::{Link, RefineStats, refine};
+
+/// What an oracle decides for a link.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Decision {
+    /// Keep the link at this level (its form factor and visibility are computed precisely).
+    Link,
+    /// Replace the link by links from each child of the emitter.
+    SubdivideEmitter,
+    /// Replace the link by links to each child of the receiver.
+    SubdivideReceiver,
+    /// Replace the link by links between every pair of children.
+    SubdivideBoth,
+    /// Drop the link (no interaction).
+    Stop,
+}
+
+/// A refinement oracle. Implementations must be pure functions of the link context (they run in
+/// parallel, and the driver's result must not depend on the order of evaluation).
+pub trait Oracle: Sync {
+    /// Short name (shown in `stats.json`).
+    fn name(&self) -> &str;
+    /// Decides for one link. The driver never asks about a self-link (emitter == receiver).
+    fn decide(&self, ctx: &mut LinkCtx<'_>) -> Decision;
+}

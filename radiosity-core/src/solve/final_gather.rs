@@ -1,0 +1,84 @@
+//! Final gather at leaf resolution: once the hierarchical system is solved, every leaf gathers again
+//! from every link at itself and at its ancestors, with the form factor evaluated for the leaf itself
+//! instead of the ancestor's average. This removes the piecewise-constant error of links attached high
+//! in the hierarchy (largest at edges and corners, where the receiver touches its sources) at the cost
+//! of one pass over each leaf's chain of links.
+
+use crate::formfactor::{self, FormFactorQuality};
+use crate::hierarchy::{ElementId, Hierarchy, NONE};
+use crate::refine::Link;
+use rayon::prelude::*;
+
+/// Recomputes leaf irradiance and radiosity from `radiosity` (per element, converged), returning new
+/// per-element `(radiosity, irradiance)`; inner elements get area-weighted means.
+#[must_use]
+pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let n = h.len();
+    let mut sorted: Vec<&Link> = links.iter().collect();
+    sorted.sort_by_key(|l| (l.receiver, l.source));
+    let mut range = vec![(0u32, 0u32); n];
+    for (k, l) in sorted.iter().enumerate() {
+        let r = &mut range[l.receiver as usize];
+        if r.1 == 0 {
+            r.0 = k as u32;
+        }
+        r.1 = k as u32 + 1;
+    }
+    let leaves: Vec<ElementId> = h.leaves().collect();
+    let gathered: Vec<[f64; 3]> = leaves
+        .par_iter()
+        .map(|&leaf| {
+            let mut acc = [0.0; 3];
+            let mut a = leaf;
+            while a != NONE {
+                let (lo, hi) = range[a as usize];
+                for l in &sorted[lo as usize..hi as usize] {
+                    let ff = if a == leaf { l.ff } else { formfactor::link_form_factor(h, l.source, leaf, FormFactorQuality::Precise) };
+                    let f = ff * l.vis;
+                    let b = radiosity[l.source as usize];
+                    for c in 0..3 {
+                        acc[c] += f * b[c];
+                    }
+                }
+                a = h.get(a).parent;
+            }
+            acc
+        })
+        .collect();
+    let mut b = radiosity.to_vec();
+    let mut irr = vec![[0.0; 3]; n];
+    for (&leaf, g) in leaves.iter().zip(gathered) {
+        let p = h.get(leaf).polygon().expect("leaves are surfaces") as usize;
+        irr[leaf as usize] = g;
+        b[leaf as usize] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * g[c]);
+    }
+    // Inner elements: area-weighted means, children before parents (reverse breadth-first order).
+    let mut order = vec![h.root];
+    let mut i = 0;
+    while i < order.len() {
+        order.extend_from_slice(h.children_of(order[i]));
+        i += 1;
+    }
+    for &e in order.iter().rev() {
+        let kids = h.children_of(e);
+        if kids.is_empty() {
+            continue;
+        }
+        let mut ab = [0.0; 3];
+        let mut ah = [0.0; 3];
+        let mut area = 0.0;
+        for &k in kids {
+            let a = h.get(k).area;
+            for c in 0..3 {
+                ab[c] += a * b[k as usize][c];
+                ah[c] += a * irr[k as usize][c];
+            }
+            area += a;
+        }
+        if area > 0.0 {
+            b[e as usize] = ab.map(|v| v / area);
+            irr[e as usize] = ah.map(|v| v / area);
+        }
+    }
+    (b, irr)
+}

@@ -1,0 +1,182 @@
+//! The ray caster and the stratified visibility estimate of a link.
+
+use crate::geom::DVec3;
+use crate::hierarchy::Hierarchy;
+use crate::scene::Scene;
+use glam::Vec3A;
+use obvhs::{BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray, triangle::Triangle};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Fraction of the segment length left out at each end, so that the endpoints' neighbours that touch
+/// them (a wall meeting the floor) do not occlude.
+pub const SEGMENT_END_EPS: f32 = 1e-5;
+
+/// How visibility is estimated.
+#[derive(Clone, Copy, Debug)]
+pub struct VisibilityConfig {
+    /// Rays per link.
+    pub rays: u32,
+    /// Seed of the per-link random sequences.
+    pub seed: u64,
+}
+
+impl Default for VisibilityConfig {
+    fn default() -> Self {
+        VisibilityConfig { rays: 16, seed: 1 }
+    }
+}
+
+/// A small, fast, seedable generator (SplitMix64). Written here because a link needs a generator
+/// derived from `(seed, source, receiver)` without any shared state, which is three lines.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed and two ids.
+    #[must_use]
+    pub fn for_link(seed: u64, a: u32, b: u32) -> Rng {
+        let mut r = Rng(seed ^ ((a as u64) << 32 | b as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        r.next_u64();
+        r
+    }
+
+    /// Next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// Ray caster over the input triangles of a scene.
+pub struct RayCaster {
+    bvh: CwBvh,
+    triangles: Vec<Triangle>,
+    /// Input polygon of each triangle, in BVH primitive order.
+    tri_polygon: Vec<u32>,
+    center: DVec3,
+    inv_scale: f64,
+    rays_cast: AtomicU64,
+}
+
+impl RayCaster {
+    /// Builds the BVH over every polygon of `scene` (quads as two triangles).
+    #[must_use]
+    pub fn new(scene: &Scene) -> RayCaster {
+        let bounds = scene.bounds();
+        let center = bounds.center();
+        let diag = bounds.diagonal();
+        let inv_scale = if diag > 0.0 { 1.0 / diag } else { 1.0 };
+        let to_f32 = |p: DVec3| {
+            let q = (p - center) * inv_scale;
+            Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
+        };
+        let mut tris = Vec::with_capacity(scene.polygons.len() * 2);
+        let mut owner = Vec::with_capacity(scene.polygons.len() * 2);
+        for (i, p) in scene.polygons.iter().enumerate() {
+            let v = p.poly.vertices();
+            for k in 1..v.len() - 1 {
+                tris.push(Triangle { v0: to_f32(v[0]), v1: to_f32(v[k]), v2: to_f32(v[k + 1]) });
+                owner.push(i as u32);
+            }
+        }
+        let mut core_time = std::time::Duration::ZERO;
+        let bvh = if tris.is_empty() {
+            CwBvh::default()
+        } else {
+            build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core_time)
+        };
+        // Reorder triangles into BVH primitive order so the callback indexes them directly.
+        let (triangles, tri_polygon) = bvh.primitive_indices.iter().map(|&i| (tris[i as usize], owner[i as usize])).unzip();
+        RayCaster { bvh, triangles, tri_polygon, center, inv_scale, rays_cast: AtomicU64::new(0) }
+    }
+
+    /// Number of rays cast so far.
+    #[must_use]
+    pub fn rays_cast(&self) -> u64 {
+        self.rays_cast.load(Ordering::Relaxed)
+    }
+
+    fn to_local(&self, p: DVec3) -> Vec3A {
+        let q = (p - self.center) * self.inv_scale;
+        Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
+    }
+
+    /// True when the open segment `a`–`b` meets no triangle other than those of polygons `skip_a`, `skip_b`.
+    #[must_use]
+    pub fn segment_clear(&self, a: DVec3, b: DVec3, skip_a: u32, skip_b: u32) -> bool {
+        self.rays_cast.fetch_add(1, Ordering::Relaxed);
+        if self.triangles.is_empty() {
+            return true;
+        }
+        let (la, lb) = (self.to_local(a), self.to_local(b));
+        let d = lb - la;
+        let len = d.length();
+        if !(len > 0.0) {
+            return true;
+        }
+        let dir = d / len;
+        let ray = Ray::new(la, dir, len * SEGMENT_END_EPS, len * (1.0 - SEGMENT_END_EPS));
+        self.bvh.ray_traverse_miss(ray, |ray, id| {
+            let owner = self.tri_polygon[id];
+            if owner == skip_a || owner == skip_b {
+                return f32::INFINITY;
+            }
+            self.triangles[id].intersect(ray)
+        })
+    }
+
+    /// Closest hit along a ray in scene coordinates: `(distance, input polygon)`.
+    #[must_use]
+    pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<(f64, u32)> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let o = self.to_local(origin);
+        let d = dir.normalize_or_zero();
+        let ray = Ray::new(o, Vec3A::new(d.x as f32, d.y as f32, d.z as f32), 0.0, f32::INFINITY);
+        let mut hit = obvhs::ray::RayHit::none();
+        if self.bvh.ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray)) {
+            Some((hit.t as f64 / self.inv_scale, self.tri_polygon[hit.primitive_id as usize]))
+        } else {
+            None
+        }
+    }
+
+    /// Fraction of `n` stratified segments between the surfaces of `source` and `receiver` that are
+    /// unoccluded. Deterministic for a given seed, independent of thread scheduling.
+    #[must_use]
+    pub fn visibility(&self, h: &Hierarchy, source: u32, receiver: u32, config: &VisibilityConfig) -> f64 {
+        let n = config.rays.max(1) as usize;
+        let mut rng = Rng::for_link(config.seed, source, receiver);
+        let k = (n as f64).sqrt().ceil() as usize;
+        // Jittered strata on both ends, the receiver's strata in a shuffled order (Fisher–Yates).
+        let mut order: Vec<u32> = (0..(k * k) as u32).collect();
+        for i in (1..order.len()).rev() {
+            let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+            order.swap(i, j);
+        }
+        let mut clear = 0usize;
+        for i in 0..n {
+            let cell_s = i % (k * k);
+            let cell_r = order[i % (k * k)] as usize;
+            let su = ((cell_s % k) as f64 + rng.next_f64()) / k as f64;
+            let sv = ((cell_s / k) as f64 + rng.next_f64()) / k as f64;
+            let ru = ((cell_r % k) as f64 + rng.next_f64()) / k as f64;
+            let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
+            let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
+            let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
+            if self.segment_clear(pa, pb, poly_a, poly_b) {
+                clear += 1;
+            }
+        }
+        clear as f64 / n as f64
+    }
+}
