@@ -16,6 +16,8 @@ pub mod formfactor;
 pub mod hierarchy;
 pub mod visibility;
 pub mod refine;
+pub mod oracle;
 pub mod solve;
 pub mod pipeline;
 pub mod output;
+pub mod instancing;

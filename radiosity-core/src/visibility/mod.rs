@@ -6,5 +6,6 @@
 //! intersection callback instead of relying on epsilons (the triangle test is not watertight).
 
 mod rays;
+pub mod shaft;
 
 pub use rays::{Rng, RayCaster, VisibilityConfig};

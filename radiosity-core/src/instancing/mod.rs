@@ -1,0 +1,1 @@
+//! Hierarchical instantiation: prototypes, instances, cached radiative properties, depth-first solve.

@@ -1,0 +1,1 @@
+//! Refinement oracles as decision graphs: tools, the per-link data manager, the DAG runtime.
