@@ -7,6 +7,7 @@ mod error;
 pub mod mgf;
 mod obj;
 pub mod shapes;
+pub mod generated;
 
 pub use builder::SceneBuilder;
 pub use cornell::cornell_box;

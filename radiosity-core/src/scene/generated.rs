@@ -1,0 +1,1 @@
+//! Procedurally generated test scenes (interiors with stairs and beams, visibility test scenes).
