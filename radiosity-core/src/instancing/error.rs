@@ -1,0 +1,66 @@
+//! Errors of the instancing step: every message names the file, the line when known, and the reason.
+
+use crate::scene::SceneError;
+use std::path::PathBuf;
+
+/// A scene file with instances that cannot be loaded, written, or solved.
+#[derive(Debug, thiserror::Error)]
+pub enum InstancingError {
+    /// A file could not be read or written.
+    #[error("{}: {what}: {source}", path.display())]
+    Io {
+        /// File that failed.
+        path: PathBuf,
+        /// What was being done (`cannot read file`, `cannot write file` ...).
+        what: String,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// A problem located at a line of a scene file (syntax, unknown name, cycle, singular transform).
+    #[error("{}:{line}: {msg}", path.display())]
+    At {
+        /// File.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        msg: String,
+    },
+    /// A prototype's OBJ file is invalid (the inner error names its file and line).
+    #[error("{}:{line}: prototype `{prototype}`: {source}", path.display())]
+    Prototype {
+        /// Scene file naming the prototype.
+        path: PathBuf,
+        /// Line of the prototype's `obj = ...` entry.
+        line: usize,
+        /// Prototype name.
+        prototype: String,
+        /// The OBJ error.
+        source: SceneError,
+    },
+    /// A material, or a scene, that the builder rejected.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A cached property file exists but cannot be decoded.
+    #[error("{}: corrupt property cache entry: {msg}", path.display())]
+    Cache {
+        /// Cache file.
+        path: PathBuf,
+        /// Decoder message.
+        msg: String,
+    },
+}
+
+impl InstancingError {
+    /// An error at `line` of `path`.
+    #[must_use]
+    pub fn at(path: &std::path::Path, line: usize, msg: impl Into<String>) -> InstancingError {
+        InstancingError::At { path: path.to_owned(), line, msg: msg.into() }
+    }
+
+    /// An I/O error on `path`.
+    #[must_use]
+    pub fn io(path: &std::path::Path, what: &str, source: std::io::Error) -> InstancingError {
+        InstancingError::Io { path: path.to_owned(), what: what.to_owned(), source }
+    }
+}

@@ -1,0 +1,344 @@
+//! The scene file with instances (TOML). Reading: [`load`] / [`parse`]; the layout is documented in
+//! the module [`crate::instancing`].
+
+use super::model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
+use super::{InstancingError, obj_mesh};
+use crate::geom::DVec3;
+use crate::scene::{Material, SceneBuilder, shapes::box_faces};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Name of the implicit root prototype made of the file's top-level content.
+pub const TOP_LEVEL_NAME: &str = "(scene)";
+
+/// A colour given as one number (grey) or three (RGB).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum ColorSpec {
+    /// The same value in every channel.
+    Grey(f64),
+    /// Red, green, blue.
+    Rgb([f64; 3]),
+}
+
+impl ColorSpec {
+    /// The three channels.
+    #[must_use]
+    pub fn rgb(self) -> [f64; 3] {
+        match self {
+            ColorSpec::Grey(x) => [x; 3],
+            ColorSpec::Rgb(c) => c,
+        }
+    }
+}
+
+/// `[[material]]`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name used by `usemtl` in prototype OBJ files and by `material = ...` entries.
+    pub name: String,
+    /// Diffuse reflectance ρ, in [0, 1).
+    pub reflectance: ColorSpec,
+    /// Diffuse transmittance t (makes the material two-sided; ρ + t < 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmittance: Option<ColorSpec>,
+    /// Emitted radiosity, W/m².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<ColorSpec>,
+    /// Both sides reflect (a side's radiosity is ρ·H(same side) + t·H(other side)).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub two_sided: bool,
+}
+
+/// A uniform or per-axis scale.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum ScaleSpec {
+    /// Uniform.
+    Uniform(f64),
+    /// Per axis.
+    Axes([f64; 3]),
+}
+
+/// `[[instance]]` or `[[prototype.instance]]`: a placement of the prototype `of`. Either `matrix`
+/// (12 numbers: a row-major 3×4 `[L | t]`, or 16: a row-major 4×4) or any of `translate`, `rotate`
+/// (degrees about x, then y, then z) and `scale`, composed as translate · rotate · scale.
+#[derive(Clone, Debug, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct InstanceSpec {
+    /// Name of the placed prototype.
+    pub of: String,
+    /// Row-major matrix, 12 or 16 numbers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix: Option<Vec<f64>>,
+    /// Translation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub translate: Option<[f64; 3]>,
+    /// Rotations about x, y, z in degrees (applied in that order).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotate: Option<[f64; 3]>,
+    /// Scale.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<ScaleSpec>,
+}
+
+/// `[[box]]`: an axis-aligned box of 6 quads.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    /// Smallest corner.
+    pub min: [f64; 3],
+    /// Largest corner.
+    pub max: [f64; 3],
+    /// Material name.
+    pub material: String,
+    /// Faces point inward (a room) instead of outward (a solid).
+    #[serde(default)]
+    pub inward: bool,
+}
+
+/// `[[polygon]]`: one planar polygon, CCW about its front normal.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolygonSpec {
+    /// Material name.
+    pub material: String,
+    /// At least 3 vertices.
+    pub vertices: Vec<[f64; 3]>,
+}
+
+/// `[[prototype]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PrototypeSpec {
+    name: Spanned<String>,
+    #[serde(default)]
+    obj: Option<Spanned<String>>,
+    #[serde(default)]
+    materials: HashMap<String, String>,
+    #[serde(default, rename = "box")]
+    boxes: Vec<Spanned<BoxSpec>>,
+    #[serde(default)]
+    polygon: Vec<Spanned<PolygonSpec>>,
+    #[serde(default)]
+    instance: Vec<Spanned<InstanceSpec>>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileSpec {
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    root: Option<Spanned<String>>,
+    #[serde(default)]
+    material: Vec<Spanned<MaterialSpec>>,
+    #[serde(default)]
+    prototype: Vec<Spanned<PrototypeSpec>>,
+    #[serde(default)]
+    obj: Option<Spanned<String>>,
+    #[serde(default)]
+    materials: HashMap<String, String>,
+    #[serde(default, rename = "box")]
+    boxes: Vec<Spanned<BoxSpec>>,
+    #[serde(default)]
+    polygon: Vec<Spanned<PolygonSpec>>,
+    #[serde(default)]
+    instance: Vec<Spanned<InstanceSpec>>,
+}
+
+/// Reads a scene file with instances. Prototype OBJ paths are relative to the file's folder.
+pub fn load(path: &Path) -> Result<InstancedScene, InstancingError> {
+    let text = std::fs::read_to_string(path).map_err(|e| InstancingError::io(path, "cannot read file", e))?;
+    let dir = path.parent().map(Path::to_owned).unwrap_or_default();
+    parse(&text, path, &dir)
+}
+
+/// Parses scene text; `path` names it in messages and `dir` is where relative OBJ paths start.
+pub fn parse(text: &str, path: &Path, dir: &Path) -> Result<InstancedScene, InstancingError> {
+    let line_of = |offset: usize| text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1;
+    let spec: FileSpec = toml::from_str(text).map_err(|e| {
+        let line = e.span().map_or(0, |s| line_of(s.start));
+        InstancingError::at(path, line, e.message().trim_end_matches('\n').replace('\n', "; "))
+    })?;
+
+    // Materials, validated by the scene builder (same rules as OBJ / MGF materials).
+    let mut validator = SceneBuilder::new(path, "");
+    let mut seen: Vec<&str> = Vec::with_capacity(spec.material.len());
+    for m in &spec.material {
+        let line = line_of(m.span().start);
+        let ms = m.get_ref();
+        if seen.contains(&ms.name.as_str()) {
+            return Err(InstancingError::at(path, line, format!("duplicate material `{}`", ms.name)));
+        }
+        let mat = Material {
+            name: ms.name.clone(),
+            reflectance: ms.reflectance.rgb(),
+            emission: ms.emission.map_or([0.0; 3], ColorSpec::rgb),
+            transmittance: ms.transmittance.map_or([0.0; 3], ColorSpec::rgb),
+            two_sided: ms.two_sided,
+        };
+        seen.push(&ms.name);
+        let _ = validator.material(mat).map_err(|e| InstancingError::at(path, line, e.to_string()))?;
+    }
+    let materials = validator.finish().materials;
+
+    // Prototype names first, so instances may refer forward.
+    let mut names: HashMap<String, PrototypeId> = HashMap::new();
+    for (i, p) in spec.prototype.iter().enumerate() {
+        let name = p.get_ref().name.get_ref();
+        if name == TOP_LEVEL_NAME || names.insert(name.clone(), i as PrototypeId).is_some() {
+            return Err(InstancingError::at(path, line_of(p.get_ref().name.span().start), format!("duplicate prototype `{name}`")));
+        }
+    }
+    let has_top = spec.obj.is_some() || !spec.boxes.is_empty() || !spec.polygon.is_empty() || !spec.instance.is_empty();
+    let ctx = Ctx { path, dir, text, materials: &materials, names: &names };
+    let mut prototypes = Vec::with_capacity(spec.prototype.len() + 1);
+    for p in &spec.prototype {
+        let p = p.get_ref();
+        prototypes.push(ctx.prototype(p.name.get_ref(), p.obj.as_ref(), &p.materials, &p.boxes, &p.polygon, &p.instance)?);
+    }
+    let root = match &spec.root {
+        Some(r) => {
+            if has_top {
+                return Err(InstancingError::at(path, line_of(r.span().start), "`root` and top-level geometry or instances cannot be combined"));
+            }
+            *names.get(r.get_ref()).ok_or_else(|| InstancingError::at(path, line_of(r.span().start), format!("unknown prototype `{}`", r.get_ref())))?
+        }
+        None => {
+            prototypes.push(ctx.prototype(TOP_LEVEL_NAME, spec.obj.as_ref(), &spec.materials, &spec.boxes, &spec.polygon, &spec.instance)?);
+            (prototypes.len() - 1) as PrototypeId
+        }
+    };
+    let name = spec.name.unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
+    let scene = InstancedScene { name, path: path.to_owned(), materials, prototypes, root };
+    scene.validate()?;
+    Ok(scene)
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    dir: &'a Path,
+    text: &'a str,
+    materials: &'a [Material],
+    names: &'a HashMap<String, PrototypeId>,
+}
+
+impl Ctx<'_> {
+    fn line(&self, offset: usize) -> usize {
+        self.text[..offset.min(self.text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+    }
+
+    fn material(&self, name: &str, line: usize) -> Result<u32, InstancingError> {
+        self.materials
+            .iter()
+            .position(|m| m.name == name)
+            .map(|i| i as u32)
+            .ok_or_else(|| InstancingError::at(self.path, line, format!("unknown material `{name}`")))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn prototype(
+        &self,
+        name: &str,
+        obj: Option<&Spanned<String>>,
+        renames: &HashMap<String, String>,
+        boxes: &[Spanned<BoxSpec>],
+        polygons: &[Spanned<PolygonSpec>],
+        instances: &[Spanned<InstanceSpec>],
+    ) -> Result<Prototype, InstancingError> {
+        let mut out = Prototype { name: name.to_owned(), ..Prototype::default() };
+        if let Some(obj) = obj {
+            let line = self.line(obj.span().start);
+            let file = self.dir.join(obj.get_ref());
+            if !file.is_file() {
+                return Err(InstancingError::at(self.path, line, format!("prototype `{name}`: missing prototype file `{}`", file.display())));
+            }
+            let mesh = obj_mesh::read(&file).map_err(|source| InstancingError::Prototype { path: self.path.to_owned(), line, prototype: name.to_owned(), source })?;
+            let target = |k: usize| renames.get(&mesh.materials[k].name).map_or(mesh.materials[k].name.as_str(), String::as_str).to_owned();
+            let map: Vec<Option<u32>> = (0..mesh.materials.len()).map(|k| self.material(&target(k), line).ok()).collect();
+            for p in &mesh.polygons {
+                let k = p.material as usize;
+                let material = map[k].ok_or_else(|| {
+                    InstancingError::at(
+                        self.path,
+                        line,
+                        format!("prototype `{name}`: material `{}` used in `{}` is not defined in the scene file", target(k), file.display()),
+                    )
+                })?;
+                out.polygons.push(LocalPolygon { poly: p.poly, material });
+            }
+            out.source = Some(PathBuf::from(obj.get_ref()));
+        }
+        // Inline geometry goes through the scene builder for validation and triangulation.
+        let mut b = SceneBuilder::new(self.path, name);
+        for m in self.materials {
+            let _ = b.material(m.clone())?;
+        }
+        let g = b.group(name);
+        for bs in boxes {
+            let line = self.line(bs.span().start);
+            let s = bs.get_ref();
+            let m = self.material(&s.material, line)?;
+            let (lo, hi) = (DVec3::from_array(s.min), DVec3::from_array(s.max));
+            if !(lo.cmplt(hi).all()) {
+                return Err(InstancingError::at(self.path, line, "box `min` must be below `max` on every axis"));
+            }
+            for (_, quad) in box_faces(lo, hi, s.inward) {
+                b.face(&quad, m, g, line)?;
+            }
+        }
+        for ps in polygons {
+            let line = self.line(ps.span().start);
+            let s = ps.get_ref();
+            let m = self.material(&s.material, line)?;
+            if s.vertices.len() < 3 {
+                return Err(InstancingError::at(self.path, line, format!("polygon needs at least 3 vertices, found {}", s.vertices.len())));
+            }
+            let vs: Vec<DVec3> = s.vertices.iter().map(|v| DVec3::from_array(*v)).collect();
+            b.face(&vs, m, g, line)?;
+        }
+        out.polygons.extend(b.finish().polygons.iter().map(|p| LocalPolygon { poly: p.poly, material: p.material }));
+        for is in instances {
+            let line = self.line(is.span().start);
+            let s = is.get_ref();
+            let prototype = *self.names.get(&s.of).ok_or_else(|| InstancingError::at(self.path, line, format!("instance of unknown prototype `{}`", s.of)))?;
+            let transform = instance_transform(s).map_err(|msg| InstancingError::at(self.path, line, msg))?;
+            if let Some(d) = transform.defect() {
+                return Err(InstancingError::at(self.path, line, format!("instance of `{}`: {d}", s.of)));
+            }
+            out.instances.push(Instance { prototype, transform, line });
+        }
+        Ok(out)
+    }
+}
+
+/// The transform an instance entry describes.
+pub fn instance_transform(s: &InstanceSpec) -> Result<Transform, String> {
+    if let Some(m) = &s.matrix {
+        if s.translate.is_some() || s.rotate.is_some() || s.scale.is_some() {
+            return Err("`matrix` cannot be combined with `translate`, `rotate` or `scale`".into());
+        }
+        return match m.len() {
+            12 => Ok(Transform::from_rows_3x4(m.as_slice().try_into().expect("length checked"))),
+            16 => {
+                let rows: [f64; 16] = m.as_slice().try_into().expect("length checked");
+                Ok(Transform { matrix: glam::DMat4::from_cols_array(&rows).transpose() })
+            }
+            n => Err(format!("`matrix` needs 12 (3×4) or 16 (4×4) numbers, found {n}")),
+        };
+    }
+    let scale = match s.scale {
+        None => DVec3::ONE,
+        Some(ScaleSpec::Uniform(k)) => DVec3::splat(k),
+        Some(ScaleSpec::Axes(a)) => DVec3::from_array(a),
+    };
+    Ok(Transform::from_trs(
+        DVec3::from_array(s.translate.unwrap_or([0.0; 3])),
+        DVec3::from_array(s.rotate.unwrap_or([0.0; 3])),
+        scale,
+    ))
+}
