@@ -193,9 +193,11 @@ fn generate(seed: u64, kind: Kind) -> (Scene, u32, u32) {
     let h = g.range(0.8, 3.0);
     let flat_p = matches!(kind, Kind::TouchingSeparate | Kind::TouchingOwnFace);
     let pc = DVec3::new(g.range(-0.3, 0.3), g.range(-0.3, 0.3), 0.0);
-    let qc = DVec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), h);
+    // With P on top of a box, Q is sometimes below it: every segment then runs through the box.
+    let q_below = flat_p && g.chance(0.5);
+    let qc = DVec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), if q_below { -h } else { h });
     let pv = element(&mut g, pc, DVec3::Z, if flat_p { 0.0 } else { 1.0 });
-    let qv = element(&mut g, qc, -DVec3::Z, 1.0);
+    let qv = element(&mut g, qc, if q_below { DVec3::Z } else { -DVec3::Z }, 1.0);
     let mid_box = |g: &mut Gen, thin: (f64, f64)| {
         let cz = g.range(0.25 * h, 0.75 * h);
         let cc = DVec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), cz);
@@ -452,7 +454,9 @@ fn candidate_lists_are_complete() {
             let parent_list = objects.candidates(&parent, None);
             let child_list = objects.candidates(&child, Some(&parent_list));
             let child_direct = objects.candidates(&child, None);
-            prop_assert_eq!(&child_list, &child_direct, "seed {:#x}: hierarchy and BVH lists differ", seed);
+            // The bounding-volume tests are not monotone (different planes), so the inherited list may
+            // be shorter than a fresh search; it is a subset, and complete (checked below).
+            prop_assert!(child_list.iter().all(|k| child_direct.contains(k)), "seed {:#x}: inherited list not within the fresh one", seed);
             for (id, _) in objects.objects.iter().enumerate() {
                 for &poly in objects.polygons_of(id as u32) {
                     let poly = &objects.polys[poly as usize];

@@ -13,6 +13,7 @@
 //! whose geometry meets the shaft is missing). Both are checked by property tests
 //! (`tests/shaft_props.rs`).
 
+mod arena;
 mod build;
 mod bvh;
 mod classify;
@@ -23,6 +24,7 @@ mod occlusion;
 mod plane;
 mod rays;
 
+pub use arena::{CandidateLists, CandidateRange};
 pub use build::{MAX_SIDE_PLANES, SHAFT_REL_TOL, Shaft, ShaftKind};
 pub use classify::{GRAZE_REL_TOL, ShaftClass, ShaftVerdict, classify, element_vertices, occludes, shaft_of};
 pub use cull::{may_intersect_aabb, may_intersect_obb};
