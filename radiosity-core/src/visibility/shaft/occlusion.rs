@@ -75,6 +75,10 @@ pub fn plate_occludes(p: &[DVec3], q: &[DVec3], plate: &Poly) -> bool {
         return false;
     }
     let vs = plate.vertices();
+    // Quick rejection: the segment between the elements' centres must cross the plate.
+    if !crosses_plate(mean(p), mean(q), &plane, vs) {
+        return false;
+    }
     // In-plane outward edge normals (the polygon is CCW about its normal), unit length.
     let mut edges = [(DVec3::ZERO, 0.0); 4];
     for k in 0..vs.len() {
@@ -104,12 +108,50 @@ pub fn solid_occludes(p: &[DVec3], q: &[DVec3], solid: &ConvexSolid) -> bool {
     if !strictly_outside(p) && !strictly_outside(q) {
         return false;
     }
-    let centre_dir = mean(q) - mean(p);
+    // Quick rejection: the segment between the elements' centres must enter the solid.
+    let (cp, cq) = (mean(p), mean(q));
+    if !segment_enters(cp, cq, &solid.planes) {
+        return false;
+    }
+    let centre_dir = cq - cp;
     let own = [centre_dir, loop_normal(p), loop_normal(q)];
     own.into_iter()
         .chain(solid.planes.iter().map(|pl| pl.normal))
         .filter_map(DVec3::try_normalize)
         .any(|m| section_inside(p, q, m, &solid.planes, tol))
+}
+
+/// Whether the segment `a`–`b` meets the interior of the intersection of `planes` (a necessary
+/// condition for occlusion: the segment between the centres is one of the blocked segments).
+fn segment_enters(a: DVec3, b: DVec3, planes: &[Plane]) -> bool {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for pl in planes {
+        let (da, db) = (pl.distance(a), pl.distance(b));
+        let slope = db - da;
+        if slope == 0.0 {
+            if da >= 0.0 {
+                return false;
+            }
+        } else if slope > 0.0 {
+            t1 = t1.min(-da / slope);
+        } else {
+            t0 = t0.max(-da / slope);
+        }
+        if t0 >= t1 {
+            return false;
+        }
+    }
+    true
+}
+
+/// Whether the segment `a`–`b` crosses the plane of the convex polygon `vs` inside it.
+fn crosses_plate(a: DVec3, b: DVec3, plane: &Plane, vs: &[DVec3]) -> bool {
+    let (ha, hb) = (plane.distance(a), plane.distance(b));
+    if (ha < 0.0) == (hb < 0.0) || ha == hb {
+        return false;
+    }
+    let c = a + (b - a) * (ha / (ha - hb));
+    (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(c - vs[k]).dot(plane.normal) >= 0.0)
 }
 
 /// Smallest and largest signed distance of the points to `plane`.

@@ -5,6 +5,7 @@
 //! generator, strata and order), so with a complete candidate list both give the same estimate up
 //! to the `f32` rounding of the global caster.
 
+use super::classify::shaft_of;
 use super::objects::ShaftObjects;
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
@@ -81,6 +82,9 @@ fn segment_hits_polygon(a: DVec3, d: DVec3, poly: &Poly) -> bool {
 /// tested only against the `candidates` objects (a shaft's list). Returns the fraction and the
 /// number of segments cast. Deterministic for a given seed; correct when `candidates` holds every
 /// object that meets the link's shaft (as [`ShaftObjects::candidates`] guarantees).
+///
+/// Before casting, the candidates are narrowed to their polygons whose vertices reach the link's
+/// shaft (exact per shaft plane), largest first so that blocked segments stop early.
 #[must_use]
 pub fn visibility_among(
     objects: &ShaftObjects,
@@ -90,6 +94,18 @@ pub fn visibility_among(
     candidates: &[u32],
     config: &VisibilityConfig,
 ) -> (f64, u32) {
+    let shaft = shaft_of(h, source, receiver);
+    let own = [h.get(source).polygon(), h.get(receiver).polygon()];
+    let mut polys: Vec<(f64, u32)> = Vec::new();
+    for &id in candidates {
+        for &k in objects.polygons_of(id) {
+            let poly = &objects.polys[k as usize];
+            if !own.contains(&Some(k)) && shaft.may_intersect_points(poly.vertices()) {
+                polys.push((poly.area(), k));
+            }
+        }
+    }
+    polys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     let n = config.rays.max(1) as usize;
     let mut rng = Rng::for_link(config.seed, source, receiver);
     let k = (n as f64).sqrt().ceil() as usize;
@@ -108,7 +124,9 @@ pub fn visibility_among(
         let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
         let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
         let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
-        if candidates.is_empty() || segment_clear_among(objects, candidates, pa, pb, poly_a, poly_b) {
+        let d = pb - pa;
+        let blocked = polys.iter().any(|&(_, k)| k != poly_a && k != poly_b && segment_hits_polygon(pa, d, &objects.polys[k as usize]));
+        if !blocked {
             clear += 1;
         }
     }
