@@ -18,7 +18,7 @@ pub fn to_dot(graph: &Graph, labels: Option<&[String]>) -> String {
             .iter()
             .map(|a| match a {
                 Arg::Param(p) => p.to_string(),
-                Arg::Number(x) => format!("{x}"),
+                Arg::Number(x) => crate::model::format_number(*x),
             })
             .collect();
         let call = if args.is_empty() { n.tool.name.to_string() } else { format!("{}({})", n.tool.name, args.join(", ")) };

@@ -10,5 +10,5 @@ pub mod validate;
 
 pub use catalogue::{BUILTIN_TOOLS, Slot, ToolInfo, ToolKind};
 pub use dot::to_dot;
-pub use model::{Arg, Arm, DecisionKind, Graph, List, Node, NodeId, Param, ParamType, ParamValue, Str, Target, ToolRef};
+pub use model::{Arg, Arm, DecisionKind, Graph, List, Node, NodeId, Param, ParamType, ParamValue, Str, Target, ToolRef, format_number};
 pub use validate::{Checked, ErrorKind, GraphError, Resolved, Site, ToolLookup, validate};

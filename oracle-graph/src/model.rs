@@ -188,6 +188,14 @@ pub enum ParamValue {
     },
 }
 
+/// A number as a person writes it: plain for ordinary magnitudes, in exponent form for very large
+/// or very small ones (`1e300`, not three hundred digits).
+#[must_use]
+pub fn format_number(x: f64) -> String {
+    let a = x.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e6).contains(&a) { format!("{x:e}") } else { format!("{x}") }
+}
+
 /// A named parameter of a graph.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Param {
@@ -206,10 +214,10 @@ impl Param {
             ParamValue::Computed { .. } => Err(format!("parameter `{}` is computed per link and cannot be set", self.name)),
             ParamValue::Fixed { min, max, .. } => {
                 if !value.is_finite() || value < *min || value > *max {
-                    return Err(format!("parameter `{}` = {value} is outside {}", self.name, self.range_text()));
+                    return Err(format!("parameter `{}` = {} is outside {}", self.name, format_number(value), self.range_text()));
                 }
                 if self.ty == ParamType::U32 && value.fract() != 0.0 {
-                    return Err(format!("parameter `{}` = {value} is not a whole number", self.name));
+                    return Err(format!("parameter `{}` = {} is not a whole number", self.name, format_number(value)));
                 }
                 Ok(())
             }
@@ -220,7 +228,7 @@ impl Param {
     #[must_use]
     pub fn range_text(&self) -> String {
         match &self.value {
-            ParamValue::Fixed { min, max, .. } => format!("[{min}, {max}]"),
+            ParamValue::Fixed { min, max, .. } => format!("[{}, {}]", format_number(*min), format_number(*max)),
             ParamValue::Computed { .. } => "computed".to_owned(),
         }
     }

@@ -35,3 +35,16 @@ pub fn expand(input: TokenStream) -> TokenStream {
     }
     out
 }
+
+/// [`expand`] on source text (for tests and tools); text that does not lex becomes a
+/// `compile_error!`.
+#[must_use]
+pub fn expand_str(src: &str) -> TokenStream {
+    match src.parse::<TokenStream>() {
+        Ok(tokens) => expand(tokens),
+        Err(e) => {
+            let msg = format!("oracle! input does not lex: {e}");
+            quote!(::core::compile_error!(#msg);)
+        }
+    }
+}

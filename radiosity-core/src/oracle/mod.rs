@@ -87,7 +87,9 @@ pub fn param_list(graph: &graph::Graph) -> String {
         .params
         .iter()
         .map(|p| match &p.value {
-            graph::ParamValue::Fixed { default, .. } => format!("{}: {} = {default} in {}", p.name, p.ty.rust_name(), p.range_text()),
+            graph::ParamValue::Fixed { default, .. } => {
+                format!("{}: {} = {} in {}", p.name, p.ty.rust_name(), graph::format_number(*default), p.range_text())
+            }
             graph::ParamValue::Computed { source } => format!("{}: {} = computed {source}", p.name, p.ty.rust_name()),
         })
         .collect();
