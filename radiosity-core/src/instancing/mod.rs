@@ -42,6 +42,7 @@
 //! sides exact, transmittance dropped); the prototype properties ([`properties`], random-walk method)
 //! account for the transmittance.
 
+pub mod bench;
 mod error;
 pub mod flatten;
 pub mod format;

@@ -20,7 +20,6 @@
 use super::flatten::{FlattenOptions, flatten_prototype};
 use super::model::{InstancedScene, PrototypeId, Transform};
 use super::InstancingError;
-use crate::formfactor::point_polygon;
 use crate::geom::{Aabb, DVec3};
 use crate::pipeline;
 use crate::refine::{BfHand, BfParams};
@@ -36,8 +35,6 @@ pub const CACHE_VERSION: u32 = 1;
 pub const MAX_BOUNCES: u32 = 256;
 /// Offset of a bounced ray's origin off the surface, relative to the prototype's box diagonal.
 pub const RAY_OFFSET_REL: f64 = 1e-5;
-/// Distance and size of the emitter of the radiosity method, in box diagonals.
-pub const EMITTER_DISTANCE_DIAGONALS: f64 = 20.0;
 
 /// How the escape albedo is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -294,6 +291,16 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
     props
 }
 
+/// Smallest magnitude given to a ray direction's component: the BVH traversal divides by the
+/// components, and an exact zero can make it miss hits on faces aligned with the ray.
+pub const MIN_DIRECTION_COMPONENT: f64 = 1e-9;
+
+/// Closest hit along a ray, with no exactly-zero direction component.
+fn cast(caster: &RayCaster, origin: DVec3, d: DVec3) -> Option<(f64, u32)> {
+    let nudged = d.to_array().map(|x| if x.abs() < MIN_DIRECTION_COMPONENT { MIN_DIRECTION_COMPONENT.copysign(x) } else { x });
+    caster.closest_hit(origin, DVec3::from_array(nudged))
+}
+
 /// An orthonormal pair perpendicular to unit `d`.
 fn basis(d: DVec3) -> (DVec3, DVec3) {
     let helper = if d.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
@@ -357,7 +364,7 @@ fn trace_direction(flat: &Scene, caster: &RayCaster, bounds: &Aabb, w: DVec3, co
             continue;
         }
         n_box += 1;
-        match caster.closest_hit(origin, d) {
+        match cast(caster, origin, d) {
             None => n_pass += 1,
             Some((t, p)) => {
                 n_hit += 1;
@@ -403,7 +410,7 @@ fn walk(flat: &Scene, caster: &RayCaster, mut x: DVec3, mut d: DVec3, mut poly: 
         };
         d = cosine_dir(out_normal, rng);
         x += out_normal * (RAY_OFFSET_REL * diag);
-        match caster.closest_hit(x, d) {
+        match cast(caster, x, d) {
             None => return weight,
             Some((t, p)) => {
                 x += d * t;
@@ -414,17 +421,17 @@ fn walk(flat: &Scene, caster: &RayCaster, mut x: DVec3, mut d: DVec3, mut poly: 
     [0.0; 3]
 }
 
-/// Escape albedo from a local hierarchical radiosity solve: the prototype (two-sided surfaces as
-/// back-to-back pairs) lit by a black square emitter far away along `w`, scaled so that the
-/// irradiance at the box centre facing it is 1; albedo = 1 − absorbed / (a(ω)·1).
-fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, a_eff: f64, eps: f64) -> [f64; 3] {
-    if a_eff <= 0.0 {
-        return [0.0; 3];
-    }
-    let diag = bounds.diagonal();
-    let c = bounds.center();
+/// Shadow rays per polygon and direction of the radiosity method (a 3 × 3 stratified grid).
+pub const DIRECT_SAMPLES_PER_SIDE: u32 = 3;
+
+/// Escape albedo from a local hierarchical radiosity solve of the prototype (two-sided surfaces as
+/// back-to-back pairs, transmittance dropped) under a unit directional irradiance along `w`. The
+/// directional light is not an emitter of the solve: each polygon's direct irradiance `H₀` is
+/// computed by shadow rays, the first reflection `ρ·H₀` is the solve's emission, and the solve adds
+/// every further interreflection `H₁`; then albedo = 1 − Σ(1 − ρ)(H₀ + H₁)A / ΣH₀A.
+fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, _a_eff: f64, eps: f64) -> [f64; 3] {
+    let diag = bounds.diagonal().max(f64::MIN_POSITIVE);
     let mut scene = flat.clone();
-    // Two-sided surfaces as pairs (the local solver is one-sided).
     let n0 = scene.polygons.len();
     for i in 0..n0 {
         let p = scene.polygons[i].clone();
@@ -432,22 +439,38 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, a_eff: f64, eps: f64)
             scene.polygons.push(Polygon { poly: super::flatten::reversed(&p.poly), ..p });
         }
     }
-    let n_proto = scene.polygons.len();
-    let (u, v) = basis(w);
-    let dist = EMITTER_DISTANCE_DIAGONALS * diag;
-    let half = 0.5 * EMITTER_DISTANCE_DIAGONALS * diag;
-    let e0 = c + w * dist;
-    // CCW about -w (the emitter faces the prototype).
-    let verts = [e0 - u * half - v * half, e0 - u * half + v * half, e0 + u * half + v * half, e0 + u * half - v * half];
-    let f = point_polygon(c, w, &verts, -w);
-    if !(f > 0.0) {
+    let caster = RayCaster::new(&scene);
+    let k = DIRECT_SAMPLES_PER_SIDE;
+    let mut materials = Vec::with_capacity(scene.polygons.len());
+    let mut direct = Vec::with_capacity(scene.polygons.len());
+    for (i, p) in scene.polygons.iter().enumerate() {
+        let n = p.poly.normal();
+        let cos = n.dot(w);
+        let mut h0 = 0.0;
+        if cos > 0.0 {
+            let mut clear = 0u32;
+            for s in 0..k * k {
+                let x = p.poly.sample((f64::from(s % k) + 0.5) / f64::from(k), (f64::from(s / k) + 0.5) / f64::from(k)) + n * (RAY_OFFSET_REL * diag);
+                if caster.segment_clear(x, x + w * (2.0 * diag), i as u32, u32::MAX) {
+                    clear += 1;
+                }
+            }
+            h0 = cos * f64::from(clear) / f64::from(k * k);
+        }
+        let m = &scene.materials[p.material as usize];
+        let mut mat = Material::diffuse(&format!("p{i}"), m.reflectance);
+        mat.emission = m.reflectance.map(|r| r * h0);
+        materials.push(mat);
+        direct.push(h0);
+    }
+    for (i, p) in scene.polygons.iter_mut().enumerate() {
+        p.material = i as u32;
+    }
+    scene.materials = materials;
+    let intercepted: f64 = scene.polygons.iter().zip(&direct).map(|(p, h)| h * p.poly.area()).sum();
+    if !(intercepted > 0.0) {
         return [0.0; 3];
     }
-    let mut light = Material::diffuse("(directional light)", [0.0; 3]);
-    light.emission = [1.0 / f; 3];
-    let li = scene.materials.len() as u32;
-    scene.materials.push(light);
-    scene.polygons.push(Polygon { poly: crate::geom::Poly::quad(verts[0], verts[1], verts[2], verts[3]), material: li, group: 0 });
     let oracle = BfHand { params: BfParams { eps } };
     let solved = pipeline::run(&scene, &oracle, &pipeline::Config::default(), &|_| {});
     let h = &solved.hierarchy;
@@ -455,16 +478,13 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, a_eff: f64, eps: f64)
     for leaf in h.leaves() {
         let e = h.get(leaf);
         let Some(p) = e.polygon() else { continue };
-        if p as usize >= n_proto {
-            continue;
-        }
         let rho = h.reflectance[p as usize];
         let irr = solved.solution.irradiance[leaf as usize];
         for ch in 0..3 {
-            absorbed[ch] += (1.0 - rho[ch]) * irr[ch] * e.area;
+            absorbed[ch] += (1.0 - rho[ch]) * (irr[ch] + direct[p as usize]) * e.area;
         }
     }
-    absorbed.map(|x| (1.0 - x / a_eff).clamp(0.0, 1.0))
+    absorbed.map(|x| (1.0 - x / intercepted).clamp(0.0, 1.0))
 }
 
 /// An on-disk cache of [`RadiativeProperties`], one JSON file per entry named

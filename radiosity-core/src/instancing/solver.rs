@@ -62,7 +62,7 @@ impl Default for InstancedConfig {
             properties: PropertyConfig::default(),
             cache_dir: None,
             max_closed_polygons: 20_000,
-            wall_margin: 0.02,
+            wall_margin: 0.25,
         }
     }
 }
