@@ -12,7 +12,16 @@ use radiosity_core::visibility::{RayCaster, VisibilityConfig};
 /// Rays per link for the reference visibility.
 const RAYS: u32 = 256;
 
-fn check_link(objects: &ShaftObjects, h: &Hierarchy, caster: &RayCaster, light: u32, tread: u32, parent: Option<&[u32]>, depth: u32, n_checked: &mut usize) {
+/// What every check of one bounding volume shares.
+struct Setup<'a> {
+    objects: &'a ShaftObjects,
+    h: &'a Hierarchy,
+    caster: &'a RayCaster,
+    light: u32,
+}
+
+fn check_link(n_checked: &mut usize, s: &Setup<'_>, tread: u32, parent: Option<&[u32]>, depth: u32) {
+    let Setup { objects, h, caster, light } = *s;
     let config = VisibilityConfig { rays: RAYS, seed: 7 };
     let verdict = shaft::classify(objects, h, light, tread, parent);
     let global = caster.visibility(h, light, tread, &config);
@@ -27,7 +36,7 @@ fn check_link(objects: &ShaftObjects, h: &Hierarchy, caster: &RayCaster, light: 
     assert!((restricted - global).abs() <= 2.0 / RAYS as f64, "light {light} -> {tread}: restricted {restricted} vs global {global}");
     if depth > 0 {
         for &c in h.children_of(tread).to_vec().iter() {
-            check_link(objects, h, caster, light, c, Some(&verdict.candidates), depth - 1, n_checked);
+            check_link(n_checked, s, c, Some(&verdict.candidates), depth - 1);
         }
     }
 }
@@ -53,8 +62,9 @@ fn stairs_behind_beam_are_never_dark() {
         let objects = ShaftObjects::new(&scene, &ObjectConfig { volume, ..ObjectConfig::default() });
         assert!(objects.n_solids() >= 11, "steps and beam are closed solids");
         let mut n_checked = 0;
+        let setup = Setup { objects: &objects, h: &h, caster: &caster, light };
         for &t in &treads {
-            check_link(&objects, &h, &caster, light, t, None, 2, &mut n_checked);
+            check_link(&mut n_checked, &setup, t, None, 2);
         }
         assert_eq!(n_checked, 10 * (1 + 4 + 16));
     }

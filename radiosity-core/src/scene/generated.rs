@@ -75,13 +75,13 @@ impl Gen {
         }
     }
 
-    /// A straight flight of `n` steps rising along +x from `(x0, y0)` to height `y0 + rise`,
-    /// between `z0` and `z1`; each step a solid box from the floor up.
-    fn stairs(&mut self, x0: f64, y0: f64, z0: f64, z1: f64, n: usize, going: f64, rise: f64, mat: u32) {
+    /// A straight flight of `n` steps rising along +x from `start` (its low corner) by `rise` in
+    /// all, each `going` deep, between `start.z` and `z1`; each step a solid box from the floor up.
+    fn stairs(&mut self, start: DVec3, z1: f64, (n, going, rise): (usize, f64, f64), mat: u32) {
         let step_h = rise / n as f64;
         for k in 0..n {
-            let xa = x0 + k as f64 * going;
-            self.solid(DVec3::new(xa, y0, z0), DVec3::new(xa + going, y0 + (k + 1) as f64 * step_h, z1), mat, "step");
+            let xa = start.x + k as f64 * going;
+            self.solid(DVec3::new(xa, start.y, start.z), DVec3::new(xa + going, start.y + (k + 1) as f64 * step_h, z1), mat, "step");
         }
     }
 
@@ -115,7 +115,7 @@ pub fn duplex() -> Scene {
     g.solid(DVec3::new(0.0, y0, 0.0), DVec3::new(2.0, y1, 1.2), concrete, "slab");
     g.solid(DVec3::new(6.0, y0, 0.0), DVec3::new(w, y1, 1.2), concrete, "slab");
     // Stairs along the +x wall side of the well, rising from the ground floor to the slab top.
-    g.stairs(2.0, 0.0, 0.05, 1.15, 16, 0.25, y1, wood);
+    g.stairs(DVec3::new(2.0, 0.0, 0.05), 1.15, (16, 0.25, y1), wood);
     // Beams under the slab and under the roof, across the short side.
     for k in 1..5 {
         let x = k as f64 * 2.0 - 0.1;

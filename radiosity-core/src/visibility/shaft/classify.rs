@@ -109,10 +109,8 @@ pub fn classify(objects: &ShaftObjects, h: &Hierarchy, emitter: ElementId, recei
 /// convex solid or through one of its polygons (other than the `own` polygons). Conservative.
 #[must_use]
 pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: &[Option<u32>]) -> bool {
-    if let Some(solid) = objects.solid_of(id) {
-        if solid_occludes(p, q, solid) {
-            return true;
-        }
+    if objects.solid_of(id).is_some_and(|solid| solid_occludes(p, q, solid)) {
+        return true;
     }
     objects.polygons_of(id).iter().filter(|&&k| !own.contains(&Some(k))).any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
 }

@@ -142,6 +142,7 @@ fn principal_axes(points: &[DVec3]) -> Option<[DVec3; 3]> {
 }
 
 /// Eigenvectors (columns) of a symmetric 3×3 matrix by cyclic Jacobi rotations.
+#[allow(clippy::needless_range_loop)] // Rotations update rows p and q together.
 fn jacobi_eigenvectors(mut a: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     for _sweep in 0..32 {
