@@ -369,7 +369,7 @@ fn check_cycles(cx: &mut Ctx<'_>, start: Option<Resolved>, arms: &[Vec<Option<Re
     }
 }
 
-/// Every node is reachable from the start.
+/// Every node is reachable from the start (duplicates, reported already, excepted).
 fn check_reachable(cx: &mut Ctx<'_>, start: Option<Resolved>, arms: &[Vec<Option<Resolved>>]) {
     let n = arms.len();
     let mut seen = vec![false; n];
@@ -392,7 +392,9 @@ fn check_reachable(cx: &mut Ctx<'_>, start: Option<Resolved>, arms: &[Vec<Option
         }
     }
     for (i, s) in seen.iter().enumerate() {
-        if !s {
+        // A duplicate is already reported; its copy is never reached by name.
+        let duplicate = cx.graph.nodes[..i].iter().any(|n| n.name == cx.graph.nodes[i].name);
+        if !s && !duplicate {
             let name = cx.graph.nodes[i].name.to_string();
             cx.error(ErrorKind::UnreachableNode, Site::Node(NodeId(i as u32)), format!("node `{name}` is unreachable from `start`"));
         }
