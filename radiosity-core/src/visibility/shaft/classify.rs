@@ -5,7 +5,7 @@
 use super::build::Shaft;
 use super::cull::may_intersect_obb;
 use super::objects::{BoundingVolume, ShaftObjects};
-use super::occlusion::{plate_occludes, solid_occludes};
+use super::occlusion::{convex_polygon_occludes, plate_occludes, solid_occludes};
 use super::plane::{aabb_corners, min_dot_aabb};
 use crate::geom::DVec3;
 use crate::hierarchy::{ElementId, Hierarchy};
@@ -106,13 +106,19 @@ pub fn classify(objects: &ShaftObjects, h: &Hierarchy, emitter: ElementId, recei
 }
 
 /// Whether object `id` blocks every segment between the hulls of `p` and `q` on its own, as a closed
-/// convex solid or through one of its polygons (other than the `own` polygons). Conservative.
+/// convex solid, through one of its polygons, or through one of its merged plates (never using the
+/// `own` polygons, which the ray caster ignores). Conservative.
 #[must_use]
 pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: &[Option<u32>]) -> bool {
     if objects.solid_of(id).is_some_and(|solid| solid_occludes(p, q, solid)) {
         return true;
     }
     objects.polygons_of(id).iter().filter(|&&k| !own.contains(&Some(k))).any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
+        || objects
+            .merged_of(id)
+            .iter()
+            .filter(|m| !m.polygons.iter().any(|&k| own.contains(&Some(k))))
+            .any(|m| convex_polygon_occludes(p, q, &m.vertices))
 }
 
 /// How deep the hull of `points` reaches into the shaft: the smallest, over the shaft's planes, of

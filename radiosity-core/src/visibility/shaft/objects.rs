@@ -6,6 +6,7 @@
 //! longest axis until every piece is small enough. Big groups (a whole building's walls) would
 //! otherwise have a bounding volume that meets every shaft; pieces keep the volumes tight.
 
+use super::merge::{MergedPlate, merge_coplanar};
 use super::obb::Obb;
 use super::plane::Plane;
 use crate::geom::{Aabb, DVec3, Poly};
@@ -69,6 +70,7 @@ pub struct ShaftObject {
     pub obb: Obb,
     poly_range: (u32, u32),
     hull_range: Option<(u32, u32)>,
+    merged_range: (u32, u32),
     /// Index into [`ShaftObjects::solid`] when the object is a closed convex solid.
     pub solid: Option<u32>,
 }
@@ -81,6 +83,7 @@ pub struct ShaftObjects {
     object_polygons: Vec<u32>,
     hull_points: Vec<DVec3>,
     solids: Vec<ConvexSolid>,
+    merged: Vec<MergedPlate>,
     /// Geometry of every input polygon, by polygon index.
     pub polys: Vec<Poly>,
     /// Object of every input polygon.
@@ -105,6 +108,7 @@ impl ShaftObjects {
             object_polygons: Vec::with_capacity(polys.len()),
             hull_points: Vec::new(),
             solids: Vec::new(),
+            merged: Vec::new(),
             polygon_object: vec![u32::MAX; polys.len()],
             polys,
             volume: config.volume,
@@ -159,7 +163,12 @@ impl ShaftObjects {
             self.solids.push(s);
             (self.solids.len() - 1) as u32
         });
-        self.objects.push(ShaftObject { group, aabb, obb, poly_range: (start, self.object_polygons.len() as u32), hull_range, solid });
+        let merged_start = self.merged.len() as u32;
+        if solid.is_none() {
+            self.merged.extend(merge_coplanar(&self.polys, members, aabb.diagonal()));
+        }
+        let merged_range = (merged_start, self.merged.len() as u32);
+        self.objects.push(ShaftObject { group, aabb, obb, poly_range: (start, self.object_polygons.len() as u32), hull_range, merged_range, solid });
     }
 
     /// Number of objects.
@@ -191,6 +200,19 @@ impl ShaftObjects {
     #[must_use]
     pub fn solid_of(&self, id: u32) -> Option<&ConvexSolid> {
         self.objects[id as usize].solid.map(|k| &self.solids[k as usize])
+    }
+
+    /// The merged plates of object `id` (coplanar polygons joined into convex unions; none for solids).
+    #[must_use]
+    pub fn merged_of(&self, id: u32) -> &[MergedPlate] {
+        let (s, e) = self.objects[id as usize].merged_range;
+        &self.merged[s as usize..e as usize]
+    }
+
+    /// Number of merged plates in all objects.
+    #[must_use]
+    pub fn n_merged(&self) -> usize {
+        self.merged.len()
     }
 
     /// Number of objects detected as closed convex solids.

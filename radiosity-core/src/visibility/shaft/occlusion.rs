@@ -63,34 +63,38 @@ fn mean(vs: &[DVec3]) -> DVec3 {
 /// (each given by its vertices: a polygon's, or a cluster's 8 box corners). Conservative.
 #[must_use]
 pub fn plate_occludes(p: &[DVec3], q: &[DVec3], plate: &Poly) -> bool {
-    if p.is_empty() || q.is_empty() {
+    convex_polygon_occludes(p, q, plate.vertices())
+}
+
+/// [`plate_occludes`] for a planar convex polygon given by its vertex loop (any number of vertices,
+/// counter-clockwise about its normal), such as a [`super::MergedPlate`]. Conservative.
+#[must_use]
+pub fn convex_polygon_occludes(p: &[DVec3], q: &[DVec3], vs: &[DVec3]) -> bool {
+    if p.is_empty() || q.is_empty() || vs.len() < 3 {
         return false;
     }
-    let Some(plane) = Plane::try_through(plate.normal(), plate.centroid()) else { return false };
-    let tol = tolerance(p, q, &Aabb::from_points(plate.vertices()));
+    let Some(plane) = Plane::try_through(loop_normal(vs), mean(vs)) else { return false };
+    let tol = tolerance(p, q, &Aabb::from_points(vs));
     let (p_min, p_max) = extent_along(p, &plane);
     let (q_min, q_max) = extent_along(q, &plane);
     let separated = (p_max < -tol && q_min > tol) || (q_max < -tol && p_min > tol);
     if !separated {
         return false;
     }
-    let vs = plate.vertices();
     // Quick rejection: the segment between the elements' centres must cross the plate.
     if !crosses_plate(mean(p), mean(q), &plane, vs) {
         return false;
     }
     // In-plane outward edge normals (the polygon is CCW about its normal), unit length.
-    let mut edges = [(DVec3::ZERO, 0.0); 4];
-    for k in 0..vs.len() {
-        let Some(e) = (vs[(k + 1) % vs.len()] - vs[k]).cross(plane.normal).try_normalize() else { return false };
-        edges[k] = (e, e.dot(vs[k]));
-    }
-    let edges = &edges[..vs.len()];
+    let edge = |k: usize| -> Option<(DVec3, f64)> {
+        let e = (vs[(k + 1) % vs.len()] - vs[k]).cross(plane.normal).try_normalize()?;
+        Some((e, e.dot(vs[k])))
+    };
     p.iter().all(|&a| {
         q.iter().all(|&b| {
             let (ha, hb) = (plane.distance(a), plane.distance(b));
             let c = a + (b - a) * (ha / (ha - hb));
-            edges.iter().all(|&(e, off)| e.dot(c) <= off - tol)
+            (0..vs.len()).all(|k| edge(k).is_some_and(|(e, off)| e.dot(c) <= off - tol))
         })
     })
 }

@@ -78,6 +78,44 @@ fn segment_hits_polygon(a: DVec3, d: DVec3, poly: &Poly) -> bool {
     (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(x - vs[k]).dot(n) >= 0.0)
 }
 
+/// A polygon ready for many segment tests: its plane and in-plane outward edge planes.
+struct PreparedPolygon {
+    polygon: u32,
+    normal: DVec3,
+    offset: f64,
+    edges: [(DVec3, f64); 4],
+    n_edges: usize,
+}
+
+impl PreparedPolygon {
+    fn new(poly: &Poly, polygon: u32) -> Option<PreparedPolygon> {
+        let normal = poly.area_vector().try_normalize()?;
+        let vs = poly.vertices();
+        let mut edges = [(DVec3::ZERO, 0.0); 4];
+        for k in 0..vs.len() {
+            let e = (vs[(k + 1) % vs.len()] - vs[k]).cross(normal);
+            edges[k] = (e, e.dot(vs[k]));
+        }
+        Some(PreparedPolygon { polygon, normal, offset: normal.dot(vs[0]), edges, n_edges: vs.len() })
+    }
+
+    /// Same contract as [`segment_hits_polygon`] for the segment `a`–`b`.
+    #[inline]
+    fn hit_by(&self, a: DVec3, b: DVec3) -> bool {
+        let sa = self.normal.dot(a) - self.offset;
+        let sb = self.normal.dot(b) - self.offset;
+        if (sa > 0.0) == (sb > 0.0) || sa == sb {
+            return false;
+        }
+        let t = sa / (sa - sb);
+        if !(SEGMENT_END_EPS..=1.0 - SEGMENT_END_EPS).contains(&t) {
+            return false;
+        }
+        let x = a + (b - a) * t;
+        self.edges[..self.n_edges].iter().all(|&(e, off)| e.dot(x) <= off)
+    }
+}
+
 /// Visibility fraction of the link `source` → `receiver` from `config.rays` stratified segments,
 /// tested only against the `candidates` objects (a shaft's list). Returns the fraction and the
 /// number of segments cast. Deterministic for a given seed; correct when `candidates` holds every
@@ -96,16 +134,18 @@ pub fn visibility_among(
 ) -> (f64, u32) {
     let shaft = shaft_of(h, source, receiver);
     let own = [h.get(source).polygon(), h.get(receiver).polygon()];
-    let mut polys: Vec<(f64, u32)> = Vec::new();
+    let mut polys: Vec<(f64, PreparedPolygon)> = Vec::new();
     for &id in candidates {
         for &k in objects.polygons_of(id) {
             let poly = &objects.polys[k as usize];
             if !own.contains(&Some(k)) && shaft.may_intersect_points(poly.vertices()) {
-                polys.push((poly.area(), k));
+                if let Some(prepared) = PreparedPolygon::new(poly, k) {
+                    polys.push((poly.area(), prepared));
+                }
             }
         }
     }
-    polys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    polys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.polygon.cmp(&b.1.polygon)));
     let n = config.rays.max(1) as usize;
     let mut rng = Rng::for_link(config.seed, source, receiver);
     let k = (n as f64).sqrt().ceil() as usize;
@@ -124,8 +164,7 @@ pub fn visibility_among(
         let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
         let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
         let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
-        let d = pb - pa;
-        let blocked = polys.iter().any(|&(_, k)| k != poly_a && k != poly_b && segment_hits_polygon(pa, d, &objects.polys[k as usize]));
+        let blocked = polys.iter().any(|(_, p)| p.polygon != poly_a && p.polygon != poly_b && p.hit_by(pa, pb));
         if !blocked {
             clear += 1;
         }
@@ -146,5 +185,11 @@ mod tests {
         // Ends on the polygon are left out.
         assert!(!segment_hits_polygon(DVec3::new(0.5, 0.5, 2.0), d, &q));
         assert!(segment_meets_box(DVec3::new(0.5, 0.5, 1.0), d.recip(), &Aabb::from_points(q.vertices())));
+        // The prepared test agrees with the plain one.
+        let p = PreparedPolygon::new(&q, 0).unwrap();
+        for (a, b) in [((0.5, 0.5, 1.0), (0.5, 0.5, -1.0)), ((1.5, 0.5, 1.0), (1.5, 0.5, -1.0)), ((0.5, 0.5, 2.0), (0.5, 0.5, 0.0)), ((0.0, 0.0, 1.0), (1.0, 1.0, -1.0))] {
+            let (a, b) = (DVec3::from(a), DVec3::from(b));
+            assert_eq!(p.hit_by(a, b), segment_hits_polygon(a, b - a, &q), "{a} -> {b}");
+        }
     }
 }
