@@ -18,8 +18,8 @@ use radiosity_core::visibility::shaft::{self, BoundingVolume, ObjectConfig, Shaf
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Cases per occlusion property; four properties, 120,000 cases in all.
-const CASES: u32 = 30_000;
+/// Cases per occlusion property; four properties, 100,000 cases in all.
+const CASES: u32 = 25_000;
 /// Grid points per element side (8 × 8 = 64 points, 64 × 64 segments).
 const GRID: usize = 8;
 /// Ground truth: hits closer than this fraction of the segment to an end do not count (the
