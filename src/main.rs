@@ -1,1 +1,19 @@
-fn main() {}
+//! `radiosity`: command-line front end. Errors are reported as one line on stderr with a non-zero
+//! exit status; user errors never print a panic backtrace.
+
+mod cli;
+
+use clap::Parser;
+
+fn main() -> std::process::ExitCode {
+    let args = cli::Cli::parse();
+    match cli::run(args) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the chain of causes joined, the outermost first.
+            let msg: Vec<String> = e.chain().map(ToString::to_string).collect();
+            eprintln!("error: {}", msg.join(": "));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -21,8 +21,12 @@ pub struct Config {
     pub max_passes: usize,
     /// Cast rays for visibility (false: every link is taken as fully visible).
     pub use_visibility: bool,
-    /// Re-gather every leaf from its chain of links at leaf resolution after the last solve.
+    /// After the last hierarchical solve, solve again at leaf resolution (every leaf gathers from
+    /// its chain of links with its own form factors, see [`solve::LeafOperator`]); when that would
+    /// store more than `leaf_operator_max_entries` coefficients, one gather pass is done instead.
     pub final_gather: bool,
+    /// Budget of the leaf-resolution operator (coefficients, 12 bytes each).
+    pub leaf_operator_max_entries: usize,
 }
 
 impl Default for Config {
@@ -34,6 +38,7 @@ impl Default for Config {
             max_passes: 3,
             use_visibility: true,
             final_gather: true,
+            leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
         }
     }
 }
@@ -60,6 +65,11 @@ pub enum Progress {
         links: u64,
         /// Candidates waiting.
         pending: u64,
+    },
+    /// The leaf-resolution operator is being built with this many coefficients.
+    LeafSolve {
+        /// Stored (leaf, link) coefficients.
+        entries: usize,
     },
     /// A solve finished.
     Solved {
@@ -88,6 +98,8 @@ pub struct Solved {
     pub rays: u64,
     /// Refine → solve rounds done.
     pub passes: usize,
+    /// Coefficients of the leaf-resolution operator (0 when it was not used).
+    pub leaf_entries: usize,
     /// Operator applications summed over passes.
     pub iterations: usize,
     /// Time per phase.
@@ -101,8 +113,11 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let caster = RayCaster::new(scene);
     let mut timings = Timings { build: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
-    let b_ref = h.emission.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let mut radiosity = initial_radiosity(&h);
+    // Thresholds are relative to the brightest radiosity expected (emission plus the closed-scene
+    // ambient estimate), so the same eps means the same relative accuracy in a dim room and in a
+    // stiff enclosure where B is 1/(1−ρ) times the emission.
+    let b_ref = radiosity.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let mut links = Vec::new();
     let mut stats = RefineStats::default();
     let mut solution = None;
@@ -140,15 +155,26 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         solution = Some(sol);
     }
     let mut solution = solution.expect("at least one pass solves");
+    let mut leaf_entries = 0;
     if config.final_gather {
         let t = Instant::now();
-        let (b, irr) = solve::final_gather(&h, &links, &solution.radiosity);
-        solution.radiosity = b;
-        solution.irradiance = irr;
+        leaf_entries = solve::leaf_operator_entries(&h, &links);
+        if leaf_entries <= config.leaf_operator_max_entries {
+            progress(Progress::LeafSolve { entries: leaf_entries });
+            let sol = solve::solve_leaf(&h, &links, &solution.radiosity, &config.solve);
+            iterations += sol.iterations;
+            progress(Progress::Solved { pass: passes + 1, iterations: sol.iterations, residual: sol.residual });
+            solution = sol;
+        } else {
+            let (b, irr) = solve::final_gather(&h, &links, &solution.radiosity);
+            solution.radiosity = b;
+            solution.irradiance = irr;
+            leaf_entries = 0;
+        }
         timings.solve += t.elapsed().as_secs_f64();
     }
     let rays = caster.rays_cast();
-    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, iterations, timings }
+    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, iterations, timings }
 }
 
 /// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene

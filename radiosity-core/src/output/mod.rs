@@ -6,9 +6,11 @@ mod ply;
 mod render;
 mod smooth;
 mod stats;
+mod write;
 
 pub use csv::{PolygonResult, polygon_results, write_patches_csv};
 pub use ply::write_ply;
 pub use render::{RenderConfig, ToneMap, render, write_png};
 pub use smooth::CornerValues;
 pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};
+pub use write::{OutputConfig, OutputError, write_all};

@@ -97,3 +97,49 @@ pub fn power_balance(h: &Hierarchy, solution: &Solution) -> (f64, f64, [f64; 3])
     }
     (emitted, absorbed, mean.map(|m| if area > 0.0 { m / area } else { 0.0 }))
 }
+
+impl Stats {
+    /// The figures of a finished solve. `load` is the loading time, `output` the time spent writing
+    /// files (0 when not yet known), `total` the wall time of the whole command.
+    #[must_use]
+    pub fn from_solved(
+        scene: &crate::scene::Scene,
+        solved: &crate::pipeline::Solved,
+        oracle: &str,
+        params: serde_json::Value,
+        times: (f64, f64, f64),
+    ) -> Stats {
+        let (load, output, total) = times;
+        let h = &solved.hierarchy;
+        let (power_emitted, power_absorbed, radiosity_mean) = power_balance(h, &solved.solution);
+        Stats {
+            scene: scene.name.clone(),
+            oracle: oracle.to_string(),
+            params,
+            polygons: scene.polygons.len(),
+            elements: h.len(),
+            leaves: h.leaves().count(),
+            links: solved.links.len(),
+            rays: solved.rays,
+            form_factors: solved.refine_stats.form_factors,
+            iterations: solved.iterations,
+            passes: solved.passes,
+            residual: solved.solution.residual,
+            error_estimate: None,
+            time_s: StatsTimes {
+                load,
+                build: solved.timings.build,
+                refine: solved.timings.refine,
+                solve: solved.timings.solve,
+                output,
+                total,
+            },
+            peak_rss_bytes: peak_rss_bytes(),
+            left_out: Vec::new(),
+            radiosity_mean,
+            power_emitted,
+            power_absorbed,
+            warnings: scene.warnings.clone(),
+        }
+    }
+}

@@ -6,10 +6,12 @@
 
 mod final_gather;
 mod gmres;
+mod leaf;
 mod operator;
 
 pub use final_gather::final_gather;
 pub use gmres::{GmresResult, gmres};
+pub use leaf::{LEAF_OPERATOR_MAX_ENTRIES, LeafOperator, leaf_operator_entries};
 pub use operator::Operator;
 
 use crate::hierarchy::Hierarchy;
@@ -53,6 +55,18 @@ pub fn solve(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &Solve
     let op = Operator::new(h, links);
     let rhs = op.emission();
     let x0 = op.leaves_from_elements(initial);
+    let result = gmres(&|x: &[f64], y: &mut [f64]| op.apply_system(x, y), &rhs, x0, config);
+    let (radiosity, irradiance) = op.expand(&result.x);
+    Solution { radiosity, irradiance, iterations: result.iterations, residual: result.residual, converged: result.converged }
+}
+
+/// Solves the leaf-resolution system ([`LeafOperator`]) starting from `initial` (per element, usually
+/// the hierarchical solution).
+#[must_use]
+pub fn solve_leaf(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &SolveConfig) -> Solution {
+    let op = LeafOperator::new(h, links);
+    let rhs = op.hierarchical().emission();
+    let x0 = op.hierarchical().leaves_from_elements(initial);
     let result = gmres(&|x: &[f64], y: &mut [f64]| op.apply_system(x, y), &rhs, x0, config);
     let (radiosity, irradiance) = op.expand(&result.x);
     Solution { radiosity, irradiance, iterations: result.iterations, residual: result.residual, converged: result.converged }

@@ -116,7 +116,22 @@ impl<'a> Operator<'a> {
         (b, hsum)
     }
 
-    fn pull(&self, x: &[f64]) -> Vec<[f64; 3]> {
+    /// The hierarchy.
+    #[must_use]
+    pub fn hierarchy(&self) -> &'a Hierarchy {
+        self.h
+    }
+
+    /// Leaf reflectance, interleaved RGB in unknown order.
+    #[must_use]
+    pub fn reflectance(&self) -> &[f64] {
+        &self.rho
+    }
+
+    /// Per-element values from leaf values `x`: leaves copied, inner elements the area-weighted mean
+    /// of their children.
+    #[must_use]
+    pub fn pull(&self, x: &[f64]) -> Vec<[f64; 3]> {
         let mut b = vec![[0.0; 3]; self.n];
         for (i, &e) in self.leaves.iter().enumerate() {
             b[e as usize] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];

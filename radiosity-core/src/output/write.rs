@@ -1,0 +1,69 @@
+//! Writes the four output files of a solve into a directory.
+
+use super::{CornerValues, RenderConfig, Stats, ToneMap, polygon_results, render, write_patches_csv, write_ply, write_png};
+use crate::pipeline::Solved;
+use crate::scene::Scene;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// A file that could not be written.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: cannot write: {reason}", path.display())]
+pub struct OutputError {
+    /// The file.
+    pub path: PathBuf,
+    /// Why.
+    pub reason: String,
+}
+
+/// Which files to write (all by default).
+#[derive(Clone, Copy, Debug)]
+pub struct OutputConfig {
+    /// Render `image.png`.
+    pub image: bool,
+    /// Image settings.
+    pub render: RenderConfig,
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        OutputConfig { image: true, render: RenderConfig::default() }
+    }
+}
+
+fn create(path: &Path) -> Result<BufWriter<std::fs::File>, OutputError> {
+    std::fs::File::create(path).map(BufWriter::new).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
+}
+
+/// Writes `patches.csv`, `solution.ply`, `image.png` (unless disabled) and `stats.json` into `dir`
+/// (created if needed). `stats` is written as given, after the other files.
+pub fn write_all(dir: &Path, scene: &Scene, solved: &Solved, stats: &Stats, config: &OutputConfig) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|e| OutputError { path: dir.to_path_buf(), reason: e.to_string() })?;
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |e: std::io::Error| OutputError { path, reason: e.to_string() }
+    };
+    let results = polygon_results(&solved.hierarchy, &solved.solution);
+    let path = dir.join("patches.csv");
+    let mut w = create(&path)?;
+    write_patches_csv(&mut w, scene, &results).and_then(|()| std::io::Write::flush(&mut w)).map_err(io(&path))?;
+
+    let per_polygon: Vec<[f64; 3]> = results.iter().map(|r| r.b).collect();
+    let tone = ToneMap::from_scene(scene, &per_polygon);
+    let corners = CornerValues::new(&solved.hierarchy, &solved.solution);
+    let path = dir.join("solution.ply");
+    let mut w = create(&path)?;
+    write_ply(&mut w, &solved.hierarchy, &corners, &tone).and_then(|()| std::io::Write::flush(&mut w)).map_err(io(&path))?;
+
+    if config.image {
+        let path = dir.join("image.png");
+        let rgb = render(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &config.render);
+        write_png(&path, &rgb, config.render.width, config.render.height).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+    }
+
+    let path = dir.join("stats.json");
+    let mut w = create(&path)?;
+    serde_json::to_writer_pretty(&mut w, stats).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+    std::io::Write::write_all(&mut w, b"\n").and_then(|()| std::io::Write::flush(&mut w)).map_err(io(&path))?;
+    Ok(())
+}

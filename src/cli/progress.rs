@@ -1,0 +1,47 @@
+//! Progress on the terminal: a spinner line per phase (refinement has no known total), hidden when
+//! stderr is not a terminal or with `--quiet`.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use radiosity::pipeline::Progress;
+use std::io::IsTerminal;
+use std::time::Duration;
+
+/// A progress display that may be hidden.
+pub struct Reporter {
+    bar: ProgressBar,
+}
+
+impl Reporter {
+    /// Visible only when `!quiet` and stderr is a terminal.
+    pub fn new(quiet: bool) -> Reporter {
+        let bar = if quiet || !std::io::stderr().is_terminal() {
+            ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden())
+        } else {
+            let bar = ProgressBar::new_spinner();
+            bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}").expect("static template"));
+            bar.enable_steady_tick(Duration::from_millis(120));
+            bar
+        };
+        Reporter { bar }
+    }
+
+    /// Shows a phase name.
+    pub fn phase(&self, msg: &str) {
+        self.bar.set_message(msg.to_string());
+    }
+
+    /// Shows a pipeline event.
+    pub fn event(&self, p: Progress) {
+        let msg = match p {
+            Progress::Refine { pass, links, pending } => format!("refine pass {pass}: {links} links, {pending} candidates pending"),
+            Progress::LeafSolve { entries } => format!("leaf-resolution solve: {entries} coefficients"),
+            Progress::Solved { pass, iterations, residual } => format!("solve pass {pass}: {iterations} iterations, residual {residual:.1e}"),
+        };
+        self.bar.set_message(msg);
+    }
+
+    /// Removes the line.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
