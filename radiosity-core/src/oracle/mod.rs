@@ -10,8 +10,10 @@
 pub mod bench;
 pub mod bf;
 mod probe;
+pub mod registry;
 pub mod runtime;
 pub mod scenes;
+pub mod study;
 pub mod tools;
 
 pub use oracle_graph as graph;
@@ -96,7 +98,7 @@ pub fn param_list(graph: &graph::Graph) -> String {
     items.join(", ")
 }
 
-/// Parses `name=value` (the command line's `--param`) and sets it with `set`.
+/// Parses `name=value` (the command line's `--param`) into the name and the value.
 pub fn parse_param_assignment(text: &str) -> Result<(String, f64), ParamError> {
     let Some((name, value)) = text.split_once('=') else {
         return Err(ParamError { message: format!("expected `name=value`, found `{text}`") });
