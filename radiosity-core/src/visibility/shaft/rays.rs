@@ -138,10 +138,11 @@ pub fn visibility_among(
     for &id in candidates {
         for &k in objects.polygons_of(id) {
             let poly = &objects.polys[k as usize];
-            if !own.contains(&Some(k)) && shaft.may_intersect_points(poly.vertices()) {
-                if let Some(prepared) = PreparedPolygon::new(poly, k) {
-                    polys.push((poly.area(), prepared));
-                }
+            if own.contains(&Some(k)) || !shaft.may_intersect_points(poly.vertices()) {
+                continue;
+            }
+            if let Some(prepared) = PreparedPolygon::new(poly, k) {
+                polys.push((poly.area(), prepared));
             }
         }
     }
