@@ -1,7 +1,8 @@
 //! Shaft culling on whole scenes (issue 4): on the generated interiors and the Cornell box, for
 //! many polygon pairs, an "invisible" class is never given to a link that rays show visible, and
-//! ray casting restricted to the shaft's candidates gives the global ray caster's answer (both draw
-//! the same segments; only the global caster's `f32` rounding differs).
+//! ray casting restricted to the shaft's candidates gives exactly the answer of casting against
+//! every object, and the global ray caster's answer up to its `f32` rounding (both draw and weigh
+//! the same segments).
 
 use radiosity_core::hierarchy::{self, BuildConfig};
 use radiosity_core::scene::{Scene, cornell_box, generated};
@@ -13,8 +14,10 @@ use std::time::Instant;
 const RAYS: u32 = 64;
 /// Most pairs tested per scene (every k-th pair of the full list when there are more).
 const MAX_PAIRS: usize = 12_000;
-/// Segments on which the two casters may disagree per link (rays grazing an edge).
-const MAX_RAY_DIFF: f64 = 3.0 / RAYS as f64;
+/// Largest difference per link to the global caster: its `f32` triangles may disagree with the
+/// `f64` polygons on segments grazing an edge, and one kernel-weighted segment near a contact can
+/// carry a large share of the weight.
+const MAX_RAY_DIFF: f64 = 0.15;
 
 fn check_scene(scene: &Scene) {
     let h = hierarchy::build(scene, &BuildConfig::default());
@@ -37,6 +40,7 @@ fn check_scene(scene: &Scene) {
     let t_global = t0.elapsed().as_secs_f64();
     for volume in [BoundingVolume::Aabb, BoundingVolume::Obb, BoundingVolume::Hull] {
         let objects = ShaftObjects::new(scene, &ObjectConfig { volume, ..ObjectConfig::default() });
+        let all_objects: Vec<u32> = (0..objects.len() as u32).collect();
         let (mut n_inv, mut n_vis, mut n_part, mut n_cand, mut max_diff, mut sum_diff) = (0usize, 0usize, 0usize, 0usize, 0.0f64, 0.0f64);
         let t0 = Instant::now();
         let n_invisible_only = pairs.iter().filter(|&&(a, b)| shaft::classify(&objects, &h, a, b, None).class == ShaftClass::Invisible).count();
@@ -60,6 +64,10 @@ fn check_scene(scene: &Scene) {
                     n_part += 1;
                     let (v, k) = shaft::visibility_among(&objects, &h, a, b, &verdict.candidates, &config);
                     rays += u64::from(k);
+                    // Completeness, exactly: casting against every object draws the same segments and
+                    // can only add polygons that miss the shaft, so the answers are identical.
+                    let (v_all, _) = shaft::visibility_among(&objects, &h, a, b, &all_objects, &config);
+                    assert!(v == v_all, "{}: {a} -> {b}: candidates give {v}, all objects {v_all}: the list is incomplete", scene.name);
                     v
                 }
             };
@@ -71,7 +79,7 @@ fn check_scene(scene: &Scene) {
         let t = t0.elapsed().as_secs_f64();
         assert_eq!(n_invisible_only, n_inv, "classification is deterministic");
         eprintln!(
-            "{:<12} {:?}: {} objects ({} solids), {} pairs: invisible {n_inv}, visible {n_vis}, partial {n_part}, mean candidates {:.1}, rays {rays} vs {}, time {t:.3} s (classify alone {t_classify:.3} s) vs rays {t_global:.3} s, diff max {max_diff:.3} mean {:.2e}",
+            "{:<12} {:?}: {} objects ({} solids), {} pairs: invisible {n_inv}, visible {n_vis}, partial {n_part}, mean candidates {:.1}, rays {rays} vs {}, time with the completeness check {t:.3} s (classify alone {t_classify:.3} s), global rays {t_global:.3} s, diff max {max_diff:.3} mean {:.2e}",
             scene.name,
             volume,
             objects.len(),

@@ -1,9 +1,9 @@
 //! Ray casting restricted to a shaft's candidate occluders: the visibility fraction of a link from
 //! jittered stratified segments, tested in `f64` only against the candidates' polygons.
 //!
-//! The samples are drawn exactly as [`crate::visibility::RayCaster::visibility`] draws them (same
-//! generator, strata and order), so with a complete candidate list both give the same estimate up
-//! to the `f32` rounding of the global caster.
+//! The samples are drawn and weighted exactly as [`crate::visibility::RayCaster::visibility`] does
+//! (same generator, strata, order and kernel weights), so with a complete candidate list both give
+//! the same estimate up to the `f32` rounding of the global caster.
 
 use super::classify::shaft_of;
 use super::objects::ShaftObjects;
@@ -14,6 +14,10 @@ use crate::visibility::{Rng, VisibilityConfig};
 /// Fraction of the segment length left out at each end, as in the global ray caster, so that the
 /// endpoints' neighbours that touch them (a wall meeting the floor) do not occlude.
 pub const SEGMENT_END_EPS: f64 = 1e-5;
+
+/// Regularisation of the kernel weights of visibility samples, relative to the squared sum of the
+/// two elements' radii; the same value as the global caster's (its constant is private to it).
+pub const KERNEL_REGULARISATION: f64 = 1e-4;
 
 /// Whether the segment `a`–`b` (without its end fractions [`SEGMENT_END_EPS`]) misses every
 /// polygon of the `candidates` objects other than `skip_a` and `skip_b`.
@@ -116,9 +120,10 @@ impl PreparedPolygon {
     }
 }
 
-/// Visibility fraction of the link `source` → `receiver` from `config.rays` stratified segments,
-/// tested only against the `candidates` objects (a shaft's list). Returns the fraction and the
-/// number of segments cast. Deterministic for a given seed; correct when `candidates` holds every
+/// Visibility of the link `source` → `receiver` from `config.rays` stratified segments, tested only
+/// against the `candidates` objects (a shaft's list): the clear segments' share of the transfer
+/// kernel `cosθ_s cosθ_r / r²` (regularised), as the global caster weighs them, or the plain clear
+/// fraction when no segment carries weight. Returns the visibility and the number of segments cast. Deterministic for a given seed; correct when `candidates` holds every
 /// object that meets the link's shaft (as [`ShaftObjects::candidates`] guarantees).
 ///
 /// Before casting, the candidates are narrowed to their polygons whose vertices reach the link's
@@ -155,7 +160,8 @@ pub fn visibility_among(
         let j = (rng.next_u64() % (i as u64 + 1)) as usize;
         order.swap(i, j);
     }
-    let mut clear = 0usize;
+    let reg = KERNEL_REGULARISATION * (h.get(source).radius + h.get(receiver).radius).powi(2);
+    let (mut clear, mut w_clear, mut w_all) = (0usize, 0.0f64, 0.0f64);
     for i in 0..n {
         let cell_s = i % (k * k);
         let cell_r = order[i % (k * k)] as usize;
@@ -165,12 +171,19 @@ pub fn visibility_among(
         let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
         let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
         let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
+        let d = pb - pa;
+        let r2 = d.length_squared();
+        let (na, nb) = (h.get(poly_a).normal, h.get(poly_b).normal);
+        let w = (na.dot(d).max(0.0) * (-nb.dot(d)).max(0.0)) / (r2 * (r2 + reg));
         let blocked = polys.iter().any(|(_, p)| p.polygon != poly_a && p.polygon != poly_b && p.hit_by(pa, pb));
         if !blocked {
             clear += 1;
+            w_clear += w;
         }
+        w_all += w;
     }
-    (clear as f64 / n as f64, n as u32)
+    let v = if w_all > 0.0 && w_all.is_finite() { w_clear / w_all } else { clear as f64 / n as f64 };
+    (v, n as u32)
 }
 
 #[cfg(test)]
