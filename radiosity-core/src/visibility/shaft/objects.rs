@@ -71,7 +71,7 @@ pub struct ShaftObject {
     poly_range: (u32, u32),
     hull_range: Option<(u32, u32)>,
     merged_range: (u32, u32),
-    /// Index into [`ShaftObjects::solid`] when the object is a closed convex solid.
+    /// Index of its solid (see [`ShaftObjects::solid_of`]) when the object is a closed convex solid.
     pub solid: Option<u32>,
 }
 
