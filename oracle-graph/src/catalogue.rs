@@ -213,3 +213,13 @@ pub const BUILTIN_TOOLS: &[ToolInfo] = &[
 pub fn builtin(name: &str) -> Option<&'static ToolInfo> {
     BUILTIN_TOOLS.iter().find(|t| t.name == name)
 }
+
+/// The link data slots the built-in tools of `graph` fill, sorted and without repeats: what the
+/// data manager stores for this graph (a graph without visibility tools has no visibility slot).
+#[must_use]
+pub fn slots(graph: &crate::Graph) -> Vec<Slot> {
+    let mut out: Vec<Slot> = graph.nodes.iter().filter_map(|n| builtin(&n.tool.name)).flat_map(|t| t.slots.iter().copied()).collect();
+    out.sort();
+    out.dedup();
+    out
+}

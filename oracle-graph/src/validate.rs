@@ -66,6 +66,8 @@ pub enum ErrorKind {
     ArgumentCount,
     /// An argument naming a parameter that does not exist.
     UnknownParam,
+    /// An argument of the wrong type (an `f64` where a tool counts, a fraction as a count).
+    ArgumentType,
     /// A node without arms.
     EmptyNode,
     /// An answer handled by two arms (or twice in one).
@@ -222,7 +224,8 @@ fn resolve_arm_targets(cx: &mut Ctx<'_>, ids: &HashMap<String, NodeId>) -> Vec<V
     out
 }
 
-/// Tools exist; known tools get the right number of arguments; arguments name declared parameters.
+/// Tools exist; known tools get the right number and types of arguments; arguments name declared
+/// parameters.
 fn check_tools(cx: &mut Ctx<'_>, lookup: &dyn Fn(&str) -> ToolLookup) -> Vec<Option<&'static ToolInfo>> {
     let g = cx.graph;
     let mut out = Vec::with_capacity(g.nodes.len());
@@ -248,9 +251,27 @@ fn check_tools(cx: &mut Ctx<'_>, lookup: &dyn Fn(&str) -> ToolLookup) -> Vec<Opt
             }
         };
         for (k, arg) in n.tool.args.iter().enumerate() {
-            if let Arg::Param(p) = arg {
-                if g.param(p).is_none() {
-                    cx.error(ErrorKind::UnknownParam, Site::Arg(id, k), format!("unknown parameter `{p}`"));
+            let spec = info.and_then(|t| t.args.get(k));
+            match arg {
+                Arg::Param(p) => match (g.param(p), spec) {
+                    (None, _) => cx.error(ErrorKind::UnknownParam, Site::Arg(id, k), format!("unknown parameter `{p}`")),
+                    (Some(param), Some(spec)) if param.ty != spec.ty => cx.error(
+                        ErrorKind::ArgumentType,
+                        Site::Arg(id, k),
+                        format!("argument `{}` of `{}` is `{}`, parameter `{p}` is `{}`", spec.name, n.tool.name, spec.ty.rust_name(), param.ty.rust_name()),
+                    ),
+                    _ => {}
+                },
+                Arg::Number(x) => {
+                    if let Some(spec) = spec {
+                        if spec.ty == crate::model::ParamType::U32 && !(x.fract() == 0.0 && *x >= 0.0 && *x <= f64::from(u32::MAX)) {
+                            cx.error(
+                                ErrorKind::ArgumentType,
+                                Site::Arg(id, k),
+                                format!("argument `{}` of `{}` is a count (`u32`), found {}", spec.name, n.tool.name, crate::model::format_number(*x)),
+                            );
+                        }
+                    }
                 }
             }
         }

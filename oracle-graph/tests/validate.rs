@@ -60,6 +60,27 @@ fn unknown_nodes_tools_params_and_answers() {
 }
 
 #[test]
+fn arguments_have_the_tools_types() {
+    check(
+        "oracle G { params { eps: f64 = 0.5 } start => a; a: RayVisibility(eps) { Visible | Invisible | Partial | ProbablyVisible | ProbablyInvisible | ProbablyPartial | TooComplex => link } }",
+        &[(ErrorKind::ArgumentType, "argument `rays` of `RayVisibility` is `u32`, parameter `eps` is `f64`")],
+    );
+    check(
+        "oracle G { start => a; a: RayVisibility(2.5) { Visible | Invisible | Partial | ProbablyVisible | ProbablyInvisible | ProbablyPartial | TooComplex => link } }",
+        &[(ErrorKind::ArgumentType, "argument `rays` of `RayVisibility` is a count (`u32`), found 2.5")],
+    );
+}
+
+#[test]
+fn slots_are_those_of_the_tools_used() {
+    use oracle_graph::Slot;
+    let bf = graph("oracle G { params { eps: f64 = 0.1 } start => a; a: BfAbove(eps) { Yes => subdivide_both, No => link } }");
+    assert_eq!(oracle_graph::catalogue::slots(&bf), [Slot::FormFactorMax]);
+    let vis = graph("oracle G { start => a; a: ReferenceVisibility { Visible => link, Invisible => stop, Partial => b } b: PreciseVisibility(64) { Done => link } }");
+    assert_eq!(oracle_graph::catalogue::slots(&vis), [Slot::Visibility]);
+}
+
+#[test]
 fn every_answer_is_handled_exactly_once() {
     check(
         "oracle G { start => a; a: Facing { Yes => link } }",

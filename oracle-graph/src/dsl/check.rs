@@ -72,7 +72,8 @@ fn check_oracle<'a>(decl: &'a OracleDecl, shared: &[&'a SharedDecl], errors: &mu
     let start = match decl.starts.as_slice() {
         [] => {
             local.push(syn::Error::new_spanned(&decl.name, format!("oracle `{}` has no `start => node;`", decl.name)));
-            Target::Decision(crate::DecisionKind::Stop)
+            // Validate the rest as if it started at the first node, without a wave of unreachable nodes.
+            nodes.first().map_or(Target::Decision(crate::DecisionKind::Stop), |n| Target::parse(&n.name.to_string()))
         }
         [(_, first), rest @ ..] => {
             for (kw, _) in rest {
@@ -125,8 +126,8 @@ fn check_param(p: &ParamDecl, errors: &mut Errors) -> Option<Param> {
     let param = Param { name: Cow::Owned(p.name.to_string()), ty, value };
     if let (ParamValueDecl::Fixed { default, .. }, ParamValue::Fixed { default: d, .. }) = (&p.value, &param.value) {
         if let Err(msg) = param.check(*d) {
+            // Kept in the graph so its uses are not reported as unknown too.
             errors.push(syn::Error::new_spanned(&default.tokens, format!("default of {msg}")));
-            return None;
         }
     }
     Some(param)
