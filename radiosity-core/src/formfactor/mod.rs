@@ -5,8 +5,10 @@
 //! that the receiver's area-averaged irradiance is `H_R = F · V · B_S` (`V` the visibility fraction,
 //! `B_S` the source's area-averaged radiosity). For surfaces, `F` is the classic form factor `F(R→S)`.
 
+mod contour;
 mod link;
 mod point_polygon;
 
+pub use contour::polygon_polygon;
 pub use link::{FormFactorQuality, MAX_PROBE_PULL, estimate, estimate_max, link_form_factor};
 pub use point_polygon::{clip_to_halfspace, point_polygon, point_polygon_unclipped};
