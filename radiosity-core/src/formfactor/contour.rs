@@ -20,9 +20,9 @@ use std::f64::consts::PI;
 /// Edges closer to parallel than this (sine of the angle) use the parallel closed form.
 pub const PARALLEL_SIN_TOL: f64 = 1e-9;
 /// Relative tolerance of the adaptive outer integral.
-pub const OUTER_REL_TOL: f64 = 1e-11;
+pub const OUTER_REL_TOL: f64 = 1e-9;
 /// Deepest bisection of the outer integral.
-pub const OUTER_MAX_DEPTH: u32 = 30;
+pub const OUTER_MAX_DEPTH: u32 = 20;
 
 /// `F(1→2)` for planar polygons `p1`, `p2` (counter-clockwise about their front normals, fronts facing).
 #[must_use]
