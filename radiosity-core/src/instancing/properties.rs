@@ -296,7 +296,7 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
 pub const MIN_DIRECTION_COMPONENT: f64 = 1e-9;
 
 /// Closest hit along a ray, with no exactly-zero direction component.
-fn cast(caster: &RayCaster, origin: DVec3, d: DVec3) -> Option<(f64, u32)> {
+pub(super) fn cast(caster: &RayCaster, origin: DVec3, d: DVec3) -> Option<(f64, u32)> {
     let nudged = d.to_array().map(|x| if x.abs() < MIN_DIRECTION_COMPONENT { MIN_DIRECTION_COMPONENT.copysign(x) } else { x });
     caster.closest_hit(origin, DVec3::from_array(nudged))
 }
@@ -331,8 +331,13 @@ fn hits_box(b: &Aabb, o: DVec3, d: DVec3) -> bool {
 
 /// Cosine-distributed unit direction about unit `n`.
 fn cosine_dir(n: DVec3, rng: &mut Rng) -> DVec3 {
-    let (u, v) = basis(n);
     let (r1, r2) = (rng.next_f64(), rng.next_f64());
+    cosine_dir_from(n, r1, r2)
+}
+
+/// Cosine-distributed unit direction about unit `n` from two uniform numbers in [0, 1).
+pub(super) fn cosine_dir_from(n: DVec3, r1: f64, r2: f64) -> DVec3 {
+    let (u, v) = basis(n);
     let r = r1.sqrt();
     let phi = 2.0 * PI * r2;
     (u * (r * phi.cos()) + v * (r * phi.sin()) + n * (1.0 - r1).max(0.0).sqrt()).normalize_or_zero()

@@ -1,15 +1,16 @@
 //! The instanced solver: a chain of small hierarchical radiosity problems solved depth-first.
 //!
-//! At one level the local problem holds the level's own polygons, one proxy per closed instance and,
-//! below the top, six walls carrying the light that arrived at the instance:
+//! At one level the local problem holds the level's own polygons and one proxy per closed instance;
+//! below the top, the light that arrived at the instance is held fixed:
 //! - a closed instance is a proxy box: its prototype's box shrunk about its centre by
 //!   `√(1 − τ̄)` (so that its projected area is the mean effective area ā = (1 − τ̄)·Ā_box), with the
 //!   prototype's mean escape albedo as reflectance; it blocks, absorbs and reflects like the
 //!   prototype on average over directions and takes no self-link (a box face sees no other face);
-//! - opening an instance: its box, enlarged by [`InstancedConfig::wall_margin`], becomes six inward
-//!   black walls emitting the irradiance the proxy's matching face received (the links that arrived
-//!   at the instance, copied to the new local root as a diffuse light field per face); the local
-//!   problem is refined and solved with that outside held fixed (its root self-link is the local
+//! - opening an instance: the irradiance each face of its proxy received (the links that arrived at
+//!   the instance) is a diffuse light field entering through that face of the instance's box; every
+//!   polygon of the opened level gathers it by [`InstancedConfig::incoming_rays`] cosine-distributed
+//!   rays that leave the box unblocked, and reflects it once as its emission. The local problem is
+//!   then refined and solved with that outside held fixed (its root self-link is the local
 //!   interreflection), its own polygons are streamed to the sink, and its hierarchy is dropped
 //!   before its sub-instances are opened in turn.
 //!
@@ -50,8 +51,9 @@ pub struct InstancedConfig {
     pub cache_dir: Option<PathBuf>,
     /// Instances of prototypes with more flattened polygons than this are opened in place.
     pub max_closed_polygons: u64,
-    /// Enlargement of an opened instance's box for its walls, relative to the box's diagonal.
-    pub wall_margin: f64,
+    /// Rays per polygon gathering the light that arrived at an opened instance (rounded up to a
+    /// square number of strata).
+    pub incoming_rays: u32,
 }
 
 impl Default for InstancedConfig {
@@ -62,7 +64,7 @@ impl Default for InstancedConfig {
             properties: PropertyConfig::default(),
             cache_dir: None,
             max_closed_polygons: 20_000,
-            wall_margin: 0.25,
+            incoming_rays: 64,
         }
     }
 }
@@ -78,7 +80,7 @@ pub struct InstancedStats {
     pub leaves_out: u64,
     /// Links summed over local problems.
     pub links: u64,
-    /// Most input polygons in one local problem (own + proxy faces + walls).
+    /// Most input polygons in one local problem (own + proxy faces).
     pub max_local_polygons: usize,
     /// Most links in one local problem.
     pub max_local_links: u64,
@@ -214,7 +216,7 @@ struct Task {
     transform: Transform,
     flat_base: u64,
     /// Irradiance received by the 6 proxy faces (order of [`box_faces`]); `None` at the top.
-    walls: Option<[[f64; 3]; 6]>,
+    incoming: Option<[[f64; 3]; 6]>,
 }
 
 /// What a polygon of a local problem stands for.
@@ -222,7 +224,6 @@ struct Task {
 enum Role {
     Own { flat_index: u64, material: u32 },
     ProxyFace { slot: usize, face: usize },
-    Wall,
 }
 
 /// Solves `scene` depth-first with instances (see the module docs), streaming every finished
@@ -236,8 +237,11 @@ pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &
     let cache = config.cache_dir.as_deref().map(PropertyCache::new);
     let mut proxies: HashMap<PrototypeId, Proxy> = HashMap::new();
     let mut stats = InstancedStats::default();
-    let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, walls: None }];
-    let oracle = BfHand { params: config.bf };
+    let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, incoming: None }];
+    // The BF threshold is relative to the largest emission of the problem solved; a local problem's
+    // largest emission is often a wall's, far below the scene's lights, so its threshold is rescaled
+    // to stay relative to the scene's largest emission (the full solve's criterion).
+    let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
     while let Some(task) = stack.pop() {
         // Gather the level: own polygons of the task and of instances opened in place, and the
         // closed instances.
@@ -331,19 +335,33 @@ pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &
                 add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot, face })?;
             }
         }
-        if let Some(walls) = &task.walls {
-            let lb = bounds[task.prototype as usize];
-            let pad = DVec3::splat(config.wall_margin * lb.diagonal().max(f64::MIN_POSITIVE));
-            for (face, (_, quad)) in box_faces(lb.min - pad, lb.max + pad, true).into_iter().enumerate() {
-                let mut m = Material::diffuse(&format!("(wall {face})"), [0.0; 3]);
-                m.emission = walls[face].map(|h| h.max(0.0));
-                let mi = b.material(m)?;
-                let poly = task.transform.poly(&Poly::quad(quad[0], quad[1], quad[2], quad[3]));
-                add(&mut b, &mut roles, &poly, mi, Role::Wall)?;
-            }
-        }
-        let local = b.finish();
+        let mut local = b.finish();
         drop(own);
+        // The light that arrived at the instance: each polygon's irradiance from outside, by rays
+        // leaving it through the instance's box (blocked by the level's own geometry and proxies),
+        // each carrying the irradiance its exit face received in the parent. Its first reflection
+        // becomes the polygon's emission; the local solve adds every further interreflection.
+        let external = match &task.incoming {
+            Some(field) => incoming_irradiance(&local, &bounds[task.prototype as usize], &task.transform, field, config.incoming_rays, config.properties.seed),
+            None => Vec::new(),
+        };
+        if !external.is_empty() {
+            let mut materials = Vec::with_capacity(local.polygons.len());
+            for (i, p) in local.polygons.iter_mut().enumerate() {
+                let mut m = local.materials[p.material as usize].clone();
+                m.name = format!("p{i}");
+                m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * external[i][c]);
+                materials.push(m);
+                p.material = i as u32;
+            }
+            local.materials = materials;
+        }
+        let b_ref_local = local.polygons.iter().flat_map(|p| local.materials[p.material as usize].emission).fold(0.0, f64::max);
+        let mut bf = config.bf;
+        if b_ref_local > 0.0 && b_ref_scene > 0.0 {
+            bf.eps *= b_ref_scene / b_ref_local;
+        }
+        let oracle = BfHand { params: bf };
         stats.max_local_polygons = stats.max_local_polygons.max(local.polygons.len());
         if local.polygons.is_empty() {
             continue;
@@ -380,18 +398,67 @@ pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &
                         }
                         area += a;
                     });
-                    proxy_irradiance[slot][face] = acc.map(|x| if area > 0.0 { x / area } else { 0.0 });
+                    let ext = external.get(i).copied().unwrap_or([0.0; 3]);
+                    proxy_irradiance[slot][face] = std::array::from_fn(|c| ext[c] + if area > 0.0 { acc[c] / area } else { 0.0 });
                 }
-                Role::Wall => {}
             }
         }
         drop(solved);
         for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
-            stack.push(Task { prototype: c, transform: t, flat_base: base, walls: Some(proxy_irradiance[slot]) });
+            stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(proxy_irradiance[slot]) });
         }
     }
     stats.seconds = t0.elapsed().as_secs_f64();
     Ok(stats)
+}
+
+/// Irradiance from outside of every polygon of `local` (see the module docs). `lb` is the opened
+/// prototype's local box, `t` its placement, `field` the irradiance received by its proxy's faces.
+fn incoming_irradiance(local: &crate::scene::Scene, lb: &Aabb, t: &Transform, field: &[[f64; 3]; 6], rays: u32, seed: u64) -> Vec<[f64; 3]> {
+    use rayon::prelude::*;
+    let caster = crate::visibility::RayCaster::new(local);
+    let inv = t.matrix.inverse();
+    let diag = t.aabb(lb).diagonal().max(f64::MIN_POSITIVE);
+    let k = f64::from(rays.max(1)).sqrt().ceil() as u32;
+    local
+        .polygons
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let n = p.poly.normal();
+            let mut rng = crate::visibility::Rng::for_link(seed, i as u32, 0x1C0);
+            let mut acc = [0.0; 3];
+            for s in 0..k * k {
+                let (a, b) = ((f64::from(s % k) + rng.next_f64()) / f64::from(k), (f64::from(s / k) + rng.next_f64()) / f64::from(k));
+                let x = p.poly.sample(rng.next_f64(), rng.next_f64()) + n * (super::properties::RAY_OFFSET_REL * diag);
+                let d = super::properties::cosine_dir_from(n, a, b);
+                if super::properties::cast(&caster, x, d).is_none() {
+                    let face = exit_face(lb, inv.transform_point3(x), inv.transform_vector3(d));
+                    for c in 0..3 {
+                        acc[c] += field[face][c];
+                    }
+                }
+            }
+            acc.map(|v| v / f64::from(k * k))
+        })
+        .collect()
+}
+
+/// The face (order of [`box_faces`]: x−, x+, y−, y+, z−, z+) through which the ray `o + t·d` leaves
+/// the box `b`.
+fn exit_face(b: &Aabb, o: DVec3, d: DVec3) -> usize {
+    let mut best = (0usize, f64::INFINITY);
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            continue;
+        }
+        let (plane, face) = if d[a] > 0.0 { (b.max[a], 2 * a + 1) } else { (b.min[a], 2 * a) };
+        let t = (plane - o[a]) / d[a];
+        if t < best.1 {
+            best = (face, t);
+        }
+    }
+    best.0
 }
 
 fn proxy_of(local: &Aabb, props: &RadiativeProperties) -> Proxy {
