@@ -178,3 +178,22 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
     assert!(caster.rays_cast() > 0 && ctx.data.visibility.is_some(), "a visibility graph casts rays");
     assert_ne!(d, Decision::SubdivideReceiver);
 }
+
+#[test]
+fn visibility_study_counts_links_per_threshold_and_few_rays_err_more() {
+    let scene = radiosity::oracle::scenes::room_with_objects();
+    let mut config = Config { max_passes: 1, ..Config::default() };
+    config.build.min_area_rel = 1e-3;
+    let solved = pipeline::run(&scene, &radiosity::refine::BfHand::default(), &config, &|_| {});
+    let thresholds = [1e-4, 1e-2, 1.0, f64::INFINITY];
+    let rows = radiosity::oracle::study::visibility_study(&solved, config.visibility, &thresholds);
+    assert_eq!(rows.len(), thresholds.len());
+    assert_eq!(rows[3].links, solved.links.len() as u64, "an infinite threshold keeps every link");
+    for pair in rows.windows(2) {
+        assert!(pair[0].links <= pair[1].links, "links below a threshold grow with it: {rows:?}");
+    }
+    let all = &rows[3];
+    assert!(all.error_rate.iter().all(|e| (0.0..=1.0).contains(e)), "{all:?}");
+    assert!(all.error_rate[0] > 0.0, "4 rays misclassify some partly occluded links: {all:?}");
+    assert!(all.error_rate[2] <= all.error_rate[0], "64 rays err no more than 4: {all:?}");
+}

@@ -7,7 +7,6 @@
 
 use super::check::OracleModel;
 use super::parse::{ArgDecl, OracleDecl, ParamValueDecl};
-use crate::catalogue;
 use crate::model::{Arg, Graph, ParamType, ParamValue, Target};
 use crate::validate::Resolved;
 use proc_macro2::{Literal, Span, TokenStream};
@@ -402,10 +401,4 @@ fn float(v: f64) -> TokenStream {
         }
         text.parse().unwrap_or_else(|_| Literal::f64_unsuffixed(v).into_iter_tokens())
     }
-}
-
-/// Whether `name` is a built-in tool (so the macro emits its absolute path).
-#[must_use]
-pub fn is_builtin(name: &str) -> bool {
-    catalogue::builtin(name).is_some()
 }
