@@ -2,6 +2,7 @@
 //!
 //! The data flows one way, one module per step:
 //! - [`scene`]: load and validate OBJ / MGF / the embedded Cornell box → [`scene::Scene`]
+//! - [`analysis`]: what the scene needs (visibility? colour?) → [`analysis::SceneTraits`]
 //! - [`hierarchy`]: clusters over the input polygons, surfaces subdivided lazily → [`hierarchy::Hierarchy`]
 //! - [`formfactor`]: point-to-polygon analytic form factors, receiver quadrature, isotropic clusters
 //! - [`visibility`]: ray casting against a BVH of the input triangles
@@ -12,6 +13,7 @@
 
 pub mod geom;
 pub mod scene;
+pub mod analysis;
 pub mod formfactor;
 pub mod hierarchy;
 pub mod visibility;

@@ -1,6 +1,7 @@
 //! The whole solve, step after step: hierarchy → (refine → solve)* → a [`Solved`] result with the
 //! figures `stats.json` reports. Front ends (the CLI, tests, benchmarks) call [`run`].
 
+use crate::analysis::SceneTraits;
 use crate::hierarchy::{self, BuildConfig, Hierarchy};
 use crate::refine::{self, Link, Oracle, RefineStats};
 use crate::scene::Scene;
@@ -21,6 +22,9 @@ pub struct Config {
     pub max_passes: usize,
     /// Cast rays for visibility (false: every link is taken as fully visible).
     pub use_visibility: bool,
+    /// Analyse the scene first and leave out what it does not need (visibility in a convex
+    /// enclosure); see [`crate::analysis`].
+    pub analyse: bool,
     /// After the last hierarchical solve, solve again at leaf resolution (every leaf gathers from
     /// its chain of links with its own form factors, see [`solve::LeafOperator`]); when that would
     /// store more than `leaf_operator_max_entries` coefficients, one gather pass is done instead.
@@ -37,6 +41,7 @@ impl Default for Config {
             solve: SolveConfig::default(),
             max_passes: 3,
             use_visibility: true,
+            analyse: true,
             final_gather: true,
             leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
         }
@@ -100,6 +105,15 @@ pub struct Solved {
     pub passes: usize,
     /// Coefficients of the leaf-resolution operator (0 when it was not used).
     pub leaf_entries: usize,
+    /// What the scene needs, when analysed.
+    pub traits: Option<SceneTraits>,
+    /// Machinery left out for this scene, in words.
+    pub left_out: Vec<String>,
+    /// A-posteriori error estimate: the largest change of a leaf's radiosity (any channel) between
+    /// the hierarchical solution and the leaf-resolution one, relative to the largest leaf radiosity.
+    /// It measures the error of the piecewise-constant link approximation that the leaf solve
+    /// removes; `None` when no leaf-resolution solve was done.
+    pub error_estimate: Option<f64>,
     /// Operator applications summed over passes.
     pub iterations: usize,
     /// Time per phase.
@@ -109,6 +123,9 @@ pub struct Solved {
 /// Solves `scene` with `oracle`.
 pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn Fn(Progress)) -> Solved {
     let t0 = Instant::now();
+    let traits = config.analyse.then(|| SceneTraits::of(scene));
+    let left_out = traits.as_ref().map(SceneTraits::left_out).unwrap_or_default();
+    let use_visibility = config.use_visibility && traits.as_ref().is_none_or(|t| t.needs_visibility);
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
     let mut timings = Timings { build: t0.elapsed().as_secs_f64(), ..Timings::default() };
@@ -127,7 +144,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let t = Instant::now();
         let (new_links, s) = refine::refine(
             &mut h,
-            config.use_visibility.then_some(&caster),
+            use_visibility.then_some(&caster),
             config.visibility,
             oracle,
             links,
@@ -156,12 +173,14 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     }
     let mut solution = solution.expect("at least one pass solves");
     let mut leaf_entries = 0;
+    let mut error_estimate = None;
     if config.final_gather {
         let t = Instant::now();
         leaf_entries = solve::leaf_operator_entries(&h, &links);
         if leaf_entries <= config.leaf_operator_max_entries {
             progress(Progress::LeafSolve { entries: leaf_entries });
             let sol = solve::solve_leaf(&h, &links, &solution.radiosity, &config.solve);
+            error_estimate = Some(leaf_change(&h, &solution.radiosity, &sol.radiosity));
             iterations += sol.iterations;
             progress(Progress::Solved { pass: passes + 1, iterations: sol.iterations, residual: sol.residual });
             solution = sol;
@@ -174,7 +193,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         timings.solve += t.elapsed().as_secs_f64();
     }
     let rays = caster.rays_cast();
-    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, iterations, timings }
+    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, traits, left_out, error_estimate, iterations, timings }
 }
 
 /// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene
@@ -212,4 +231,18 @@ fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
         }
     }
     b
+}
+
+/// Largest change of a leaf radiosity between `before` and `after`, relative to the largest leaf
+/// radiosity of `after`.
+fn leaf_change(h: &Hierarchy, before: &[[f64; 3]], after: &[[f64; 3]]) -> f64 {
+    let (mut diff, mut max) = (0.0f64, 0.0f64);
+    for leaf in h.leaves() {
+        for c in 0..3 {
+            let (a, b) = (before[leaf as usize][c], after[leaf as usize][c]);
+            diff = diff.max((a - b).abs());
+            max = max.max(b.abs());
+        }
+    }
+    if max > 0.0 { diff / max } else { 0.0 }
 }

@@ -91,6 +91,14 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         s.time_s.total,
         s.peak_rss_bytes.map_or("n/a".to_string(), |b| format!("{:.1} MB", b as f64 / 1e6))
     );
+    if s.left_out.is_empty() {
+        println!("left out: nothing (the scene needs every part of the solver)");
+    } else {
+        println!("left out: {}", s.left_out.join("; "));
+    }
+    if let Some(e) = s.error_estimate {
+        println!("error estimate: {:.2}% of the largest radiosity (hierarchical vs leaf-resolution solve), in {:.3}s", 100.0 * e, s.time_s.total);
+    }
     println!("power: emitted {:.6e} W, absorbed {:.6e} W (ratio {:.5})", s.power_emitted, s.power_absorbed, balance);
     println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());
 }

@@ -31,7 +31,7 @@ pub fn estimate(h: &Hierarchy, source: u32, receiver: u32) -> f64 {
     let (s, r) = (h.get(source), h.get(receiver));
     match (s.poly(), r.poly()) {
         (Some(sp), Some(_)) => point_polygon(r.center, r.normal, sp.vertices(), s.normal),
-        _ => cluster_ff(s, r, true),
+        _ => cluster_ff(h, s, r, true),
     }
 }
 
@@ -56,7 +56,7 @@ pub fn estimate_max(h: &Hierarchy, source: u32, receiver: u32) -> f64 {
             }
             f
         }
-        _ => cluster_ff(s, r, true),
+        _ => cluster_ff(h, s, r, true),
     }
 }
 
@@ -65,7 +65,7 @@ pub fn estimate_max(h: &Hierarchy, source: u32, receiver: u32) -> f64 {
 pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: FormFactorQuality) -> f64 {
     let (s, r) = (h.get(source), h.get(receiver));
     let (Some(sp), Some(rp)) = (s.poly(), r.poly()) else {
-        return cluster_ff(s, r, false);
+        return cluster_ff(h, s, r, false);
     };
     let sv = sp.vertices();
     if quality == FormFactorQuality::Estimate {
@@ -171,10 +171,32 @@ fn adaptive_average(rp: &Poly, rn: DVec3, sv: &[DVec3], sn: DVec3, whole: f64, d
     acc / total
 }
 
-/// Isotropic cluster approximation (Sillion 1995): a cluster of total surface area `A` radiates and
-/// receives with projected area `A/4` in every direction. `conservative` shortens the distance by the
-/// bounding radii and drops the cosines (used for refinement estimates).
-fn cluster_ff(s: &Element, r: &Element, conservative: bool) -> f64 {
+/// Clusters with at most this many polygons use their members' exact projected area in the link
+/// direction; larger ones the isotropic `A/4`.
+pub const CLUSTER_EXACT_MAX_POLYGONS: usize = 1024;
+
+/// Projected area of element `e` seen from direction `dir` (unit, pointing away from the element
+/// toward the viewer): `A·max(0, n·dir)` for a surface; for a cluster the sum of its polygons'
+/// (self-occlusion inside the cluster ignored), or the isotropic `A/4` for large clusters.
+#[must_use]
+pub fn projected_area(h: &Hierarchy, e: &Element, dir: DVec3) -> f64 {
+    match e.kind {
+        crate::hierarchy::ElementKind::Surface { .. } => e.area * e.normal.dot(dir).max(0.0),
+        crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
+            let members = &h.cluster_polygons[poly_start as usize..poly_end as usize];
+            if members.len() > CLUSTER_EXACT_MAX_POLYGONS {
+                return 0.25 * e.area;
+            }
+            members.iter().map(|&p| { let el = h.get(p); el.area * el.normal.dot(dir).max(0.0) }).sum()
+        }
+    }
+}
+
+/// Cluster link coefficient (Sillion 1995, with oriented projected areas): the source radiates
+/// `B·A_proj,S(dir)/π` per steradian toward the receiver, which collects it over `A_proj,R(−dir)`,
+/// averaged over its area. `conservative` shortens the distance by the bounding radii and replaces
+/// projected areas by their upper bounds (used for refinement estimates).
+fn cluster_ff(h: &Hierarchy, s: &Element, r: &Element, conservative: bool) -> f64 {
     let d = r.center - s.center;
     let mut dist2 = d.length_squared();
     if conservative {
@@ -186,18 +208,13 @@ fn cluster_ff(s: &Element, r: &Element, conservative: bool) -> f64 {
         return 0.0;
     }
     let dir = d.normalize_or_zero(); // from source to receiver
-    // Source factor: intensity per unit radiosity, A_S cosθ_s / π for a surface, A_S / 4π for a cluster.
-    let source = if s.is_cluster() {
-        s.area / (4.0 * PI)
-    } else {
-        let c = if conservative { 1.0 } else { s.normal.dot(dir).max(0.0) };
-        s.area * c / PI
-    };
-    // Receiver factor: irradiance per unit normal irradiance.
-    let receiver = if r.is_cluster() {
-        0.25
-    } else if conservative {
+    // Source factor: intensity per unit radiosity.
+    let source = if conservative { s.area / PI } else { projected_area(h, s, dir) / PI };
+    // Receiver factor: mean irradiance over the receiver per unit normal irradiance.
+    let receiver = if conservative {
         1.0
+    } else if r.is_cluster() {
+        projected_area(h, r, -dir) / r.area.max(f64::MIN_POSITIVE)
     } else {
         (-r.normal.dot(dir)).max(0.0)
     };

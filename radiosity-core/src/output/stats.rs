@@ -47,7 +47,8 @@ pub struct Stats {
     pub passes: usize,
     /// Final relative residual of the linear system.
     pub residual: f64,
-    /// A-posteriori error estimate of the solution (null until estimated).
+    /// A-posteriori error estimate of the solution, relative to the largest leaf radiosity (see
+    /// [`crate::pipeline::Solved::error_estimate`]; null when not estimated).
     pub error_estimate: Option<f64>,
     /// Seconds per phase.
     pub time_s: StatsTimes,
@@ -125,7 +126,7 @@ impl Stats {
             iterations: solved.iterations,
             passes: solved.passes,
             residual: solved.solution.residual,
-            error_estimate: None,
+            error_estimate: solved.error_estimate,
             time_s: StatsTimes {
                 load,
                 build: solved.timings.build,
@@ -135,7 +136,7 @@ impl Stats {
                 total,
             },
             peak_rss_bytes: peak_rss_bytes(),
-            left_out: Vec::new(),
+            left_out: solved.left_out.clone(),
             radiosity_mean,
             power_emitted,
             power_absorbed,
