@@ -27,11 +27,10 @@ pub fn to_dot(graph: &Graph, labels: Option<&[String]>) -> String {
     }
     let mut used: Vec<DecisionKind> = Vec::new();
     let mut note = |t: &Target| {
-        if let Target::Decision(d) = t {
-            if !used.contains(d) {
+        if let Target::Decision(d) = t
+            && !used.contains(d) {
                 used.push(*d);
             }
-        }
     };
     note(&graph.start);
     for n in graph.nodes.iter() {

@@ -263,15 +263,14 @@ fn check_tools(cx: &mut Ctx<'_>, lookup: &dyn Fn(&str) -> ToolLookup) -> Vec<Opt
                     _ => {}
                 },
                 Arg::Number(x) => {
-                    if let Some(spec) = spec {
-                        if spec.ty == crate::model::ParamType::U32 && !(x.fract() == 0.0 && *x >= 0.0 && *x <= f64::from(u32::MAX)) {
+                    if let Some(spec) = spec
+                        && spec.ty == crate::model::ParamType::U32 && !(x.fract() == 0.0 && *x >= 0.0 && *x <= f64::from(u32::MAX)) {
                             cx.error(
                                 ErrorKind::ArgumentType,
                                 Site::Arg(id, k),
                                 format!("argument `{}` of `{}` is a count (`u32`), found {}", spec.name, n.tool.name, crate::model::format_number(*x)),
                             );
                         }
-                    }
                 }
             }
         }
@@ -298,15 +297,14 @@ fn check_answers(cx: &mut Ctx<'_>, tools: &[Option<&'static ToolInfo>]) -> Vec<V
                 } else {
                     seen.push(ans);
                 }
-                if let Some(info) = tools[i] {
-                    if info.answer_index(ans).is_none() {
+                if let Some(info) = tools[i]
+                    && info.answer_index(ans).is_none() {
                         cx.error(
                             ErrorKind::UnknownAnswer,
                             Site::Answer(id, a, k),
                             format!("`{ans}` is not an answer of `{}` (answers: {})", info.name, info.answers.join(", ")),
                         );
                     }
-                }
             }
         }
         let mut map = Vec::new();
@@ -404,12 +402,11 @@ fn check_reachable(cx: &mut Ctx<'_>, start: Option<Resolved>, arms: &[Vec<Option
     }
     while let Some(i) = todo.pop() {
         for t in arms[i].iter().flatten() {
-            if let Resolved::Node(id) = t {
-                if !seen[id.index()] {
+            if let Resolved::Node(id) = t
+                && !seen[id.index()] {
                     seen[id.index()] = true;
                     todo.push(id.index());
                 }
-            }
         }
     }
     for (i, s) in seen.iter().enumerate() {

@@ -124,12 +124,11 @@ fn check_param(p: &ParamDecl, errors: &mut Errors) -> Option<Param> {
         }
     };
     let param = Param { name: Cow::Owned(p.name.to_string()), ty, value };
-    if let (ParamValueDecl::Fixed { default, .. }, ParamValue::Fixed { default: d, .. }) = (&p.value, &param.value) {
-        if let Err(msg) = param.check(*d) {
+    if let (ParamValueDecl::Fixed { default, .. }, ParamValue::Fixed { default: d, .. }) = (&p.value, &param.value)
+        && let Err(msg) = param.check(*d) {
             // Kept in the graph so its uses are not reported as unknown too.
             errors.push(syn::Error::new_spanned(&default.tokens, format!("default of {msg}")));
         }
-    }
     Some(param)
 }
 
@@ -168,13 +167,11 @@ fn site_span(decl: &OracleDecl, nodes: &[&NodeDecl], site: Site) -> proc_macro2:
 pub fn doc_text(attrs: &[syn::Attribute]) -> String {
     let mut lines = Vec::new();
     for a in attrs {
-        if let syn::Meta::NameValue(nv) = &a.meta {
-            if nv.path.is_ident("doc") {
-                if let syn::Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
+        if let syn::Meta::NameValue(nv) = &a.meta
+            && nv.path.is_ident("doc")
+                && let syn::Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
                     lines.push(s.value().trim().to_owned());
                 }
-            }
-        }
     }
     lines.join(" ").trim().to_owned()
 }

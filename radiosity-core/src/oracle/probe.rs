@@ -150,10 +150,10 @@ impl Probe for Recorder {
         c.calls.fetch_add(1, Ordering::Relaxed);
         c.nanos.fetch_add(nanos, Ordering::Relaxed);
         c.answers[answer.min(MAX_ANSWERS - 1)].fetch_add(1, Ordering::Relaxed);
-        if self.pair == Some((ctx.emitter, ctx.receiver)) {
-            if let Ok(mut t) = self.trace.lock() {
-                t.push(TraceStep { node, answer: names.get(answer).copied().unwrap_or("?"), data: ctx.data, nanos });
-            }
+        if self.pair == Some((ctx.emitter, ctx.receiver))
+            && let Ok(mut t) = self.trace.lock()
+        {
+            t.push(TraceStep { node, answer: names.get(answer).copied().unwrap_or("?"), data: ctx.data, nanos });
         }
     }
 }

@@ -107,10 +107,10 @@ pub fn maze(cells: usize) -> Scene {
         for j in 0..n {
             let lo = j as f64;
             // Walls along z (at x = i) and along x (at z = i), each cell edge open one time in three.
-            if rng.next_u64() % 3 != 0 {
+            if !rng.next_u64().is_multiple_of(3) {
                 r.block(DVec3::new(c - t, 0.0, lo), DVec3::new(c + t, 2.0, lo + 1.0));
             }
-            if rng.next_u64() % 3 != 0 {
+            if !rng.next_u64().is_multiple_of(3) {
                 r.block(DVec3::new(lo, 0.0, c - t), DVec3::new(lo + 1.0, 2.0, c + t));
             }
         }

@@ -214,11 +214,11 @@ fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFile
             }
         };
         let param = Param { name: Cow::Owned(fp.name.clone()), ty, value };
-        if let ParamValue::Fixed { default, .. } = param.value {
-            if let Err(m) = param.check(default) {
-                errors.push(Located { path: path.to_owned(), line: Some(line), message: format!("default of {m}") });
-                continue;
-            }
+        if let ParamValue::Fixed { default, .. } = param.value
+            && let Err(m) = param.check(default)
+        {
+            errors.push(Located { path: path.to_owned(), line: Some(line), message: format!("default of {m}") });
+            continue;
         }
         params.push(param);
         param_lines.push((path.to_owned(), line));
