@@ -109,10 +109,8 @@ pub struct Solved {
     pub traits: Option<SceneTraits>,
     /// Machinery left out for this scene, in words.
     pub left_out: Vec<String>,
-    /// A-posteriori error estimate: the largest change of a leaf's radiosity (any channel) between
-    /// the hierarchical solution and the leaf-resolution one, relative to the largest leaf radiosity.
-    /// It measures the error of the piecewise-constant link approximation that the leaf solve
-    /// removes; `None` when no leaf-resolution solve was done.
+    /// A-posteriori error estimate, relative to the largest leaf radiosity: the one-step residual
+    /// against a full-resolution gather at sampled leaves (see [`solve::error_estimate`]).
     pub error_estimate: Option<f64>,
     /// Operator applications summed over passes.
     pub iterations: usize,
@@ -173,14 +171,12 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     }
     let mut solution = solution.expect("at least one pass solves");
     let mut leaf_entries = 0;
-    let mut error_estimate = None;
     if config.final_gather {
         let t = Instant::now();
         leaf_entries = solve::leaf_operator_entries(&h, &links);
         if leaf_entries <= config.leaf_operator_max_entries {
             progress(Progress::LeafSolve { entries: leaf_entries });
             let sol = solve::solve_leaf(&h, &links, &solution.radiosity, &config.solve);
-            error_estimate = Some(leaf_change(&h, &solution.radiosity, &sol.radiosity));
             iterations += sol.iterations;
             progress(Progress::Solved { pass: passes + 1, iterations: sol.iterations, residual: sol.residual });
             solution = sol;
@@ -192,6 +188,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         }
         timings.solve += t.elapsed().as_secs_f64();
     }
+    let error_estimate = Some(solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
     let rays = caster.rays_cast();
     Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, traits, left_out, error_estimate, iterations, timings }
 }
@@ -233,16 +230,3 @@ fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
     b
 }
 
-/// Largest change of a leaf radiosity between `before` and `after`, relative to the largest leaf
-/// radiosity of `after`.
-fn leaf_change(h: &Hierarchy, before: &[[f64; 3]], after: &[[f64; 3]]) -> f64 {
-    let (mut diff, mut max) = (0.0f64, 0.0f64);
-    for leaf in h.leaves() {
-        for c in 0..3 {
-            let (a, b) = (before[leaf as usize][c], after[leaf as usize][c]);
-            diff = diff.max((a - b).abs());
-            max = max.max(b.abs());
-        }
-    }
-    if max > 0.0 { diff / max } else { 0.0 }
-}

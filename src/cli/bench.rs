@@ -60,11 +60,11 @@ fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
             cmd.arg(&p);
         }
         let o = &args.options;
-        cmd.args(["--eps", &o.eps.to_string(), "--rays", &o.rays.to_string(), "--seed", &o.seed.to_string(), "--min-area", &o.min_area.to_string()]);
-        if o.allow_dark {
+        cmd.args(["--eps", &o.eps.to_string(), "--rays", &o.common.rays.to_string(), "--seed", &o.common.seed.to_string(), "--min-area", &o.common.min_area.to_string()]);
+        if o.common.allow_dark {
             cmd.arg("--allow-dark");
         }
-        if o.no_visibility {
+        if o.common.no_visibility {
             cmd.arg("--no-visibility");
         }
         if !args.json {

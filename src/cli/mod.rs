@@ -3,6 +3,7 @@
 mod bench;
 mod progress;
 mod solve;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -20,6 +21,9 @@ enum Command {
     /// Solve a scene (OBJ or MGF; the embedded Cornell box when none is given) and write
     /// image.png, solution.ply, patches.csv and stats.json.
     Solve(solve::SolveArgs),
+    /// Error against run time: solves with several oracles and thresholds, compares with a
+    /// reference, writes sweep.csv and sweep.svg.
+    Sweep(sweep::SweepArgs),
     /// Benchmarks that print tables (and JSON with --json).
     Bench {
         #[command(subcommand)]
@@ -31,6 +35,7 @@ enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Solve(args) => solve::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
         Command::Bench { which } => bench::run(which),
     }
 }
@@ -42,6 +47,13 @@ pub struct SolveOptions {
     /// radiosity.
     #[arg(long, default_value_t = radiosity::refine::BfParams::default().eps)]
     pub eps: f64,
+    #[command(flatten)]
+    pub common: CommonOptions,
+}
+
+/// Solver options other than the threshold.
+#[derive(clap::Args, Debug, Clone)]
+pub struct CommonOptions {
     /// Visibility rays per link.
     #[arg(long, default_value_t = radiosity::visibility::VisibilityConfig::default().rays)]
     pub rays: u32,
@@ -63,6 +75,18 @@ impl SolveOptions {
     /// Checks the values clap cannot.
     pub fn validate(&self) -> anyhow::Result<()> {
         anyhow::ensure!(self.eps.is_finite() && self.eps > 0.0, "--eps must be a positive number, got {}", self.eps);
+        self.common.validate()
+    }
+
+    /// The pipeline configuration these options describe.
+    pub fn config(&self) -> radiosity::pipeline::Config {
+        self.common.config()
+    }
+}
+
+impl CommonOptions {
+    /// Checks the values clap cannot.
+    pub fn validate(&self) -> anyhow::Result<()> {
         anyhow::ensure!(self.rays >= 1, "--rays must be at least 1");
         anyhow::ensure!(
             self.min_area.is_finite() && self.min_area > 0.0 && self.min_area < 1.0,

@@ -37,7 +37,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let reporter = Reporter::new(args.quiet);
     reporter.phase("loading scene");
-    let scene = load_scene(args.scene.as_ref(), args.options.allow_dark)?;
+    let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
     let load = t0.elapsed().as_secs_f64();
     let oracle = BfHand { params: BfParams { eps: args.options.eps } };
     let config = args.options.config();
@@ -46,10 +46,10 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     let t_out = Instant::now();
     let params = serde_json::json!({
         "eps": args.options.eps,
-        "rays": args.options.rays,
-        "seed": args.options.seed,
-        "min_area": args.options.min_area,
-        "visibility": !args.options.no_visibility,
+        "rays": args.options.common.rays,
+        "seed": args.options.common.seed,
+        "min_area": args.options.common.min_area,
+        "visibility": !args.options.common.no_visibility,
     });
     let mut stats = Stats::from_solved(&scene, &solved, "bf-hand", params, (load, 0.0, 0.0));
     let out_config = OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
@@ -97,7 +97,7 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         println!("left out: {}", s.left_out.join("; "));
     }
     if let Some(e) = s.error_estimate {
-        println!("error estimate: {:.2}% of the largest radiosity (hierarchical vs leaf-resolution solve), in {:.3}s", 100.0 * e, s.time_s.total);
+        println!("error estimate: {:.2}% of the largest radiosity (one-step residual against a full-resolution gather), in {:.3}s", 100.0 * e, s.time_s.total);
     }
     println!("power: emitted {:.6e} W, absorbed {:.6e} W (ratio {:.5})", s.power_emitted, s.power_absorbed, balance);
     println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());

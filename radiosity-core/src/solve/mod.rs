@@ -4,11 +4,13 @@
 //! matrix-free by restarted GMRES, which handles stiff scenes (ρ near 1) in a few dozen products
 //! instead of the O(1/(1−ρ)) sweeps of Jacobi iteration.
 
+mod estimate;
 mod final_gather;
 mod gmres;
 mod leaf;
 mod operator;
 
+pub use estimate::{ESTIMATE_BUDGET, ESTIMATE_MAX_SAMPLES, error_estimate};
 pub use final_gather::final_gather;
 pub use gmres::{GmresResult, gmres};
 pub use leaf::{LEAF_OPERATOR_MAX_ENTRIES, LeafOperator, leaf_operator_entries};
