@@ -65,6 +65,11 @@ fn main() {
             config.max_closed_polygons = n;
         }
         config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
+        config.trace = std::env::var_os("INSTANCING_TRACE").is_some();
+        config.pipeline.final_gather = std::env::var_os("INSTANCING_NO_FINAL_GATHER").is_none();
+        if let Some(r) = std::env::var("INSTANCING_VIS_RAYS").ok().and_then(|r| r.parse().ok()) {
+            config.pipeline.visibility.rays = r;
+        }
         let (row, means) = if method == "full" {
             let (row, means) = bench_full(&scene, &config).expect("full solve");
             (row, Some(means))

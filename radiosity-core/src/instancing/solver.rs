@@ -54,6 +54,8 @@ pub struct InstancedConfig {
     /// Rays per polygon gathering the light that arrived at an opened instance (rounded up to a
     /// square number of strata).
     pub incoming_rays: u32,
+    /// Print one line per local solve to standard error.
+    pub trace: bool,
 }
 
 impl Default for InstancedConfig {
@@ -65,6 +67,7 @@ impl Default for InstancedConfig {
             cache_dir: None,
             max_closed_polygons: 20_000,
             incoming_rays: 64,
+            trace: false,
         }
     }
 }
@@ -368,7 +371,19 @@ pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &
         }
 
         // Solve, stream, keep only the proxies' irradiance.
+        let t_local = std::time::Instant::now();
         let solved = pipeline::run(&local, &oracle, &config.pipeline, &|_| {});
+        if config.trace {
+            eprintln!(
+                "local solve {}: `{}` {} polygons ({} proxies), {} links, {:.3}s",
+                stats.local_solves + 1,
+                scene.prototype(task.prototype).name,
+                local.polygons.len(),
+                closed.len(),
+                solved.links.len(),
+                t_local.elapsed().as_secs_f64()
+            );
+        }
         stats.local_solves += 1;
         stats.links += solved.links.len() as u64;
         stats.max_local_links = stats.max_local_links.max(solved.links.len() as u64);
