@@ -149,3 +149,18 @@ fn changing_a_prototype_invalidates_its_cache_entry() {
     let finer = PropertyConfig { rays_per_direction: 100, ..config };
     assert_eq!(cache.get_or_compute(&scene, &content_hashes(&scene), id, &finer).unwrap().1, CacheOutcome::Computed);
 }
+
+#[test]
+fn ply_stream_holds_every_streamed_leaf() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cubes.ply");
+    let scene = parse(&eight_cubes());
+    let mut ply = instancing::PlyStream::create(&path).unwrap();
+    let stats = solve_instanced(&scene, &config(), &mut ply).unwrap();
+    ply.finish().unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let count = |key: &str| -> u64 { text.lines().find_map(|l| l.strip_prefix(key)).unwrap().trim().parse().unwrap() };
+    assert_eq!(count("element face "), stats.leaves_out);
+    let body = text.split("end_header\n").nth(1).unwrap();
+    assert_eq!(body.lines().count() as u64, count("element vertex ") + count("element face "));
+}
