@@ -42,17 +42,22 @@
 //! sides exact, transmittance dropped); the prototype properties ([`properties`], random-walk method)
 //! account for the transmittance.
 
+pub mod bench;
 mod error;
 pub mod flatten;
 pub mod format;
 pub mod model;
 pub mod obj_mesh;
 pub mod plant;
+pub mod poplar;
+pub mod properties;
+pub mod solver;
 pub mod write;
 
 pub use error::InstancingError;
 pub use flatten::{FlattenOptions, flatten, flatten_prototype};
 pub use format::{load, parse};
 pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
+pub use solver::{InstancedConfig, InstancedStats, PlyStream, PolygonMeans, RadiositySink, solve_full, solve_instanced};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};
 pub use write::write_scene;

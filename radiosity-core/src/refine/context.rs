@@ -27,7 +27,34 @@ pub struct LinkData {
     pub form_factor_max: Option<f64>,
     /// Visibility fraction and the number of rays behind it.
     pub visibility: Option<(f64, u32)>,
+    /// Smallest and largest point form factor over the receiver (estimated at the probe points).
+    pub form_factor_range: Option<(f64, f64)>,
+    /// The centre-to-centre axis and the areas projected along it.
+    pub axis: Option<LinkAxis>,
+    /// A mark left by an oracle's command tool (studies, traces); the driver ignores it.
+    pub mark: Option<u32>,
 }
+
+/// The centre-to-centre axis of a link and what is measured along it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LinkAxis {
+    /// Unit direction from the emitter's centre to the receiver's (zero when the centres coincide).
+    pub dir: crate::geom::DVec3,
+    /// Distance between the centres.
+    pub distance: f64,
+    /// Emitter area projected on the plane orthogonal to the axis (scene units²).
+    pub projected_emitter: f64,
+    /// Receiver area projected on the plane orthogonal to the axis (scene units²).
+    pub projected_receiver: f64,
+}
+
+/// Mean fraction of a cluster's area seen from a random direction (isotropic clusters: a quarter,
+/// as for the surface of a convex body).
+pub const CLUSTER_PROJECTED_FRACTION: f64 = 0.25;
+
+/// Clusters nearer than this many times the sum of the bounding radii (centre distance) are too
+/// near for the isotropic cluster approximation (the criterion of the BF oracle).
+pub const CLUSTER_NEAR_FACTOR: f64 = 2.0;
 
 /// Everything an oracle sees of one link.
 pub struct LinkCtx<'a> {
@@ -108,6 +135,60 @@ impl<'a> LinkCtx<'a> {
         };
         self.data.visibility = Some((v, rays));
         v
+    }
+
+    /// Whether a cluster is involved and the two elements are too near for the isotropic
+    /// approximation: centre distance below [`CLUSTER_NEAR_FACTOR`] times the sum of the radii.
+    #[must_use]
+    pub fn clusters_too_near(&self) -> bool {
+        let (s, r) = (self.emitter_element(), self.receiver_element());
+        (s.is_cluster() || r.is_cluster()) && (s.center - r.center).length() < CLUSTER_NEAR_FACTOR * (s.radius + r.radius)
+    }
+
+    /// Smallest and largest point-to-emitter form factor over the receiver, at the centre and near
+    /// each corner (the probe points of [`formfactor::estimate_max`]); both equal the cluster
+    /// estimate when a cluster is involved (memoised).
+    pub fn form_factor_range(&mut self) -> (f64, f64) {
+        if let Some(r) = self.data.form_factor_range {
+            return r;
+        }
+        let (s, r) = (self.emitter_element(), self.receiver_element());
+        let range = match (s.poly(), r.poly()) {
+            (Some(sp), Some(rp)) => {
+                let sv = sp.vertices();
+                let f0 = formfactor::point_polygon(r.center, r.normal, sv, s.normal);
+                let mut range = (f0, f0);
+                for &v in rp.vertices() {
+                    let x = v + formfactor::MAX_PROBE_PULL * (r.center - v);
+                    let f = formfactor::point_polygon(x, r.normal, sv, s.normal);
+                    range = (range.0.min(f), range.1.max(f));
+                }
+                range
+            }
+            _ => {
+                let f = self.form_factor(FormFactorQuality::Estimate);
+                (f, f)
+            }
+        };
+        self.data.form_factor_range = Some(range);
+        range
+    }
+
+    /// The centre-to-centre axis and the projected areas along it (memoised).
+    pub fn axis(&mut self) -> LinkAxis {
+        if let Some(a) = self.data.axis {
+            return a;
+        }
+        let (s, r) = (self.emitter_element(), self.receiver_element());
+        let d = r.center - s.center;
+        let distance = d.length();
+        let dir = d.normalize_or_zero();
+        let projected = |e: &Element| {
+            if e.is_cluster() { CLUSTER_PROJECTED_FRACTION * e.area } else { e.area * e.normal.dot(dir).abs() }
+        };
+        let a = LinkAxis { dir, distance, projected_emitter: projected(s), projected_receiver: projected(r) };
+        self.data.axis = Some(a);
+        a
     }
 
     /// Largest channel of the emitter's current radiosity.

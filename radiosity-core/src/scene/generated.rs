@@ -1,1 +1,230 @@
 //! Procedurally generated test scenes (interiors with stairs and beams, visibility test scenes).
+//!
+//! Part of step `scene`. Each function returns a validated-by-construction [`Scene`] (metres, +y
+//! up) with emitters and a camera, built through [`SceneBuilder`]. Every solid piece (step, beam,
+//! slab, table top, leg) is its own group and a closed box with outward faces, so shaft culling
+//! sees it as one convex occluder; walls, floors and ceilings are single inward-facing quads.
+
+use super::shapes::box_faces;
+use super::{Camera, Material, Scene, SceneBuilder};
+use crate::geom::DVec3;
+use std::path::Path;
+
+/// Emitted radiosity of the generated lights, W/m².
+pub const LIGHT_EXITANCE: f64 = 100.0;
+
+/// A scene builder with a few shapes and named materials.
+struct Gen {
+    b: SceneBuilder,
+    n_groups: usize,
+}
+
+impl Gen {
+    fn new(name: &str) -> Gen {
+        Gen { b: SceneBuilder::new(Path::new(&format!("{name} (generated)")), name), n_groups: 0 }
+    }
+
+    fn material(&mut self, name: &str, rho: [f64; 3], emission: f64) -> u32 {
+        let mut m = Material::diffuse(name, rho);
+        m.emission = [emission; 3];
+        self.b.material(m).expect("generated materials are valid")
+    }
+
+    fn group(&mut self, name: &str) -> u32 {
+        self.n_groups += 1;
+        self.b.group(&format!("{name}.{}", self.n_groups))
+    }
+
+    fn quad(&mut self, vs: [DVec3; 4], mat: u32, name: &str) {
+        let g = self.group(name);
+        self.b.face(&vs, mat, g, 0).expect("generated faces are finite");
+    }
+
+    /// A closed box with outward faces, one group.
+    fn solid(&mut self, lo: DVec3, hi: DVec3, mat: u32, name: &str) {
+        let g = self.group(name);
+        for (_, q) in box_faces(lo, hi, false) {
+            self.b.face(&q, mat, g, 0).expect("generated faces are finite");
+        }
+    }
+
+    /// The inward faces of a room `[lo, hi]`, each its own group; `skip` names faces left out.
+    fn room(&mut self, lo: DVec3, hi: DVec3, mat: u32, skip: &[&str]) {
+        for (face, q) in box_faces(lo, hi, true) {
+            if !skip.contains(&face) {
+                let g = self.group(&format!("wall {face}"));
+                self.b.face(&q, mat, g, 0).expect("generated faces are finite");
+            }
+        }
+    }
+
+    /// A horizontal rectangular light at height `y`, facing down.
+    fn light_down(&mut self, x0: f64, z0: f64, x1: f64, z1: f64, y: f64, mat: u32) {
+        let p = |x: f64, z: f64| DVec3::new(x, y, z);
+        self.quad([p(x0, z0), p(x1, z0), p(x1, z1), p(x0, z1)], mat, "light");
+    }
+
+    /// A table: top slab on four legs.
+    fn table(&mut self, x: f64, z: f64, y0: f64, size: (f64, f64), mat: u32) {
+        let (w, d) = size;
+        let (h, t, leg) = (0.75, 0.04, 0.05);
+        self.solid(DVec3::new(x - w / 2.0, y0 + h - t, z - d / 2.0), DVec3::new(x + w / 2.0, y0 + h, z + d / 2.0), mat, "table top");
+        for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            let (cx, cz) = (x + sx * (w / 2.0 - leg), z + sz * (d / 2.0 - leg));
+            self.solid(DVec3::new(cx - leg / 2.0, y0, cz - leg / 2.0), DVec3::new(cx + leg / 2.0, y0 + h - t, cz + leg / 2.0), mat, "table leg");
+        }
+    }
+
+    /// A straight flight of `n` steps rising along +x from `start` (its low corner) by `rise` in
+    /// all, each `going` deep, between `start.z` and `z1`; each step a solid box from the floor up.
+    fn stairs(&mut self, start: DVec3, z1: f64, (n, going, rise): (usize, f64, f64), mat: u32) {
+        let step_h = rise / n as f64;
+        for k in 0..n {
+            let xa = start.x + k as f64 * going;
+            self.solid(DVec3::new(xa, start.y, start.z), DVec3::new(xa + going, start.y + (k + 1) as f64 * step_h, z1), mat, "step");
+        }
+    }
+
+    fn finish(self, camera: Camera) -> Scene {
+        let mut s = self.b.finish();
+        s.camera = Some(camera);
+        s
+    }
+}
+
+/// A camera at `eye` looking at `target`, 50° vertical field of view, +y up.
+fn look_at(eye: DVec3, target: DVec3) -> Camera {
+    Camera { position: eye, direction: (target - eye).normalize(), up: DVec3::Y, fov_y: 50f64.to_radians() }
+}
+
+/// A two-storey "duplex" interior, 10 × 6 m, storeys 3 m high: a floor slab with a stairwell,
+/// a straight staircase up through it, ceiling beams on both storeys, a partition wall with a door
+/// opening, tables, and two ceiling lights per storey. About 300 polygons, most of them boxes.
+#[must_use]
+pub fn duplex() -> Scene {
+    let mut g = Gen::new("duplex");
+    let wall = g.material("wall", [0.7, 0.7, 0.68], 0.0);
+    let wood = g.material("wood", [0.55, 0.4, 0.25], 0.0);
+    let concrete = g.material("concrete", [0.5, 0.5, 0.5], 0.0);
+    let light = g.material("light", [0.0; 3], LIGHT_EXITANCE);
+    let (w, d, storey, slab) = (10.0, 6.0, 3.0, 0.25);
+    g.room(DVec3::ZERO, DVec3::new(w, 2.0 * storey + slab, d), wall, &[]);
+    // Floor slab between the storeys with a stairwell at x in [2, 6], z in [0, 1.2].
+    let (y0, y1) = (storey, storey + slab);
+    g.solid(DVec3::new(0.0, y0, 1.2), DVec3::new(w, y1, d), concrete, "slab");
+    g.solid(DVec3::new(0.0, y0, 0.0), DVec3::new(2.0, y1, 1.2), concrete, "slab");
+    g.solid(DVec3::new(6.0, y0, 0.0), DVec3::new(w, y1, 1.2), concrete, "slab");
+    // Stairs along the +x wall side of the well, rising from the ground floor to the slab top.
+    g.stairs(DVec3::new(2.0, 0.0, 0.05), 1.15, (16, 0.25, y1), wood);
+    // Beams under the slab and under the roof, across the short side.
+    for k in 1..5 {
+        let x = k as f64 * 2.0 - 0.1;
+        g.solid(DVec3::new(x, y0 - 0.3, 1.2), DVec3::new(x + 0.2, y0, d), wood, "beam");
+        g.solid(DVec3::new(x, 2.0 * storey + slab - 0.3, 0.0), DVec3::new(x + 0.2, 2.0 * storey + slab, d), wood, "beam");
+    }
+    // Partition wall on the ground floor with a door opening (two solid pieces and a lintel).
+    let (px, t) = (7.0, 0.1);
+    g.solid(DVec3::new(px, 0.0, 1.2), DVec3::new(px + t, y0 - 0.3, 3.0), wall, "partition");
+    g.solid(DVec3::new(px, 0.0, 4.0), DVec3::new(px + t, y0 - 0.3, d), wall, "partition");
+    g.solid(DVec3::new(px, 2.1, 3.0), DVec3::new(px + t, y0 - 0.3, 4.0), wall, "lintel");
+    // Furniture.
+    g.table(4.0, 3.5, 0.0, (1.6, 0.9), wood);
+    g.table(8.5, 3.0, 0.0, (1.2, 1.2), wood);
+    g.table(3.0, 4.0, y1, (2.0, 1.0), wood);
+    g.table(7.5, 2.5, y1, (1.2, 0.8), wood);
+    // Lights: just below the slab (ground floor) and below the roof (upper floor).
+    for (x, y) in [(1.0, y0 - 0.31), (8.4, y0 - 0.31), (3.0, 2.0 * storey + slab - 0.31), (7.0, 2.0 * storey + slab - 0.31)] {
+        g.light_down(x, 2.5, x + 0.6, 3.5, y, light);
+    }
+    g.finish(look_at(DVec3::new(9.5, 1.6, 5.8), DVec3::new(3.0, 2.5, 0.5)))
+}
+
+/// A "geometry" visibility test scene in the style of Smits and Jensen's test scenes: a room with
+/// a 5 × 5 grid of boxes of varied sizes and heights on the floor, thin plates hovering at several
+/// heights, and one square ceiling light. Exercises many small occluders of every aspect ratio.
+#[must_use]
+pub fn smits_jensen_geometry() -> Scene {
+    let mut g = Gen::new("sj-geometry");
+    let white = g.material("white", [0.75; 3], 0.0);
+    let red = g.material("red", [0.7, 0.15, 0.1], 0.0);
+    let blue = g.material("blue", [0.1, 0.2, 0.7], 0.0);
+    let light = g.material("light", [0.0; 3], LIGHT_EXITANCE);
+    let size = 6.0;
+    g.room(DVec3::ZERO, DVec3::splat(size), white, &[]);
+    for i in 0..5 {
+        for j in 0..5 {
+            let (x, z) = (0.8 + i as f64 * 1.1, 0.8 + j as f64 * 1.1);
+            let h = 0.2 + 0.25 * ((i * 3 + j * 7) % 7) as f64;
+            let half = 0.15 + 0.05 * ((i + 2 * j) % 4) as f64;
+            let mat = if (i + j) % 2 == 0 { red } else { blue };
+            g.solid(DVec3::new(x - half, 0.0, z - half), DVec3::new(x + half, h, z + half), mat, "block");
+        }
+    }
+    for (k, y) in [2.5, 3.3, 4.1].into_iter().enumerate() {
+        let x = 1.0 + 1.5 * k as f64;
+        g.solid(DVec3::new(x, y, 1.0), DVec3::new(x + 1.2, y + 0.02, 5.0), white, "plate");
+    }
+    g.light_down(2.5, 2.5, 3.5, 3.5, size - 0.01, light);
+    g.finish(look_at(DVec3::new(5.8, 4.5, 5.8), DVec3::new(2.5, 0.5, 2.5)))
+}
+
+/// A "shadow" visibility test scene in the style of Smits and Jensen's test scenes: a long
+/// rectangular area light above a floor, with occluders at several heights between them (a large
+/// square plate, a thin bar, a cube on the floor, a plate held close to the floor), producing
+/// umbrae and penumbrae of every width.
+#[must_use]
+pub fn smits_jensen_shadow() -> Scene {
+    let mut g = Gen::new("sj-shadow");
+    let white = g.material("white", [0.75; 3], 0.0);
+    let grey = g.material("grey", [0.4; 3], 0.0);
+    let light = g.material("light", [0.0; 3], LIGHT_EXITANCE);
+    let (w, h, d) = (8.0, 4.0, 6.0);
+    g.room(DVec3::ZERO, DVec3::new(w, h, d), white, &[]);
+    g.light_down(1.0, 2.7, 7.0, 3.3, h - 0.01, light);
+    g.solid(DVec3::new(1.0, 2.5, 1.0), DVec3::new(3.0, 2.55, 3.0), grey, "square plate");
+    g.solid(DVec3::new(3.5, 1.5, 0.5), DVec3::new(3.7, 1.7, 5.5), grey, "bar");
+    g.solid(DVec3::new(5.0, 0.0, 3.5), DVec3::new(6.0, 1.0, 4.5), grey, "cube");
+    g.solid(DVec3::new(6.0, 0.3, 1.0), DVec3::new(7.5, 0.32, 2.5), grey, "low plate");
+    g.finish(look_at(DVec3::new(7.5, 3.5, 5.8), DVec3::new(3.5, 0.5, 2.5)))
+}
+
+/// The published failure case of shaft occlusion (dark stairs): a straight staircase with a beam
+/// behind it, under the flight, lit by a ceiling light above. The beam hides nothing the light
+/// sees: every step's tread is directly lit. Steps and beam are solid boxes; the room is 6 × 4 × 4 m.
+#[must_use]
+pub fn stairs_with_beam() -> Scene {
+    let mut g = Gen::new("stairs-beam");
+    let white = g.material("white", [0.7; 3], 0.0);
+    let wood = g.material("wood", [0.55, 0.4, 0.25], 0.0);
+    let light = g.material("light", [0.0; 3], LIGHT_EXITANCE);
+    let (w, h, d) = (6.0, 4.0, 4.0);
+    g.room(DVec3::ZERO, DVec3::new(w, h, d), white, &[]);
+    // Steps hung from a stringer: each step a slab at its height (the space below the flight open).
+    let (n, going, rise) = (10usize, 0.3, 0.25);
+    for k in 0..n {
+        let x = 1.0 + k as f64 * going;
+        let y = (k + 1) as f64 * rise;
+        g.solid(DVec3::new(x, y - 0.05, 1.5), DVec3::new(x + going, y, 2.5), wood, "step");
+    }
+    // The beam: under the upper half of the flight (steps 6 to 10 are above it), wider than the
+    // steps, behind them as seen from the light.
+    g.solid(DVec3::new(2.6, 0.7, 1.4), DVec3::new(4.0, 0.9, 2.6), wood, "beam");
+    g.light_down(2.0, 1.5, 3.0, 2.5, h - 0.01, light);
+    g.finish(look_at(DVec3::new(5.5, 2.5, 3.8), DVec3::new(2.5, 1.2, 2.0)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::LoadOptions;
+
+    #[test]
+    fn generated_scenes_are_valid_and_lit() {
+        for scene in [duplex(), smits_jensen_geometry(), smits_jensen_shadow(), stairs_with_beam()] {
+            scene.check(Path::new(&scene.name), &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", scene.name));
+            assert_eq!(scene.warnings.degenerate_faces, 0, "{}", scene.name);
+            assert!(scene.camera.is_some());
+            assert!(scene.polygons.len() > 20, "{}: {} polygons", scene.name, scene.polygons.len());
+        }
+    }
+}

@@ -1,0 +1,529 @@
+//! The instanced solver: a chain of small hierarchical radiosity problems solved depth-first.
+//!
+//! At one level the local problem holds the level's own polygons and one proxy per closed instance;
+//! below the top, the light that arrived at the instance is held fixed:
+//! - a closed instance is a proxy box: its prototype's box shrunk about its centre by
+//!   `√(1 − τ̄)` (so that its projected area is the mean effective area ā = (1 − τ̄)·Ā_box), with the
+//!   prototype's mean escape albedo as reflectance; it blocks, absorbs and reflects like the
+//!   prototype on average over directions and takes no self-link (a box face sees no other face);
+//! - opening an instance: the irradiance each face of its proxy received (the links that arrived at
+//!   the instance) is a diffuse light field entering through that face of the instance's box; every
+//!   polygon of the opened level gathers it by [`InstancedConfig::incoming_rays`] cosine-distributed
+//!   rays that leave the box unblocked, and reflects it once as its emission. The local problem is
+//!   then refined and solved with that outside held fixed (its root self-link is the local
+//!   interreflection), its own polygons are streamed to the sink, and its hierarchy is dropped
+//!   before its sub-instances are opened in turn.
+//!
+//! Instances whose flattened polygon count exceeds [`InstancedConfig::max_closed_polygons`] are
+//! opened in place (their content joins the current level): the policy that keeps property
+//! computation and every local problem bounded. Memory is bounded by the largest local problem plus
+//! six irradiance values per pending instance; the flattened scene is never built.
+
+use super::flatten::{FlattenOptions, reversed};
+use super::model::{InstancedScene, PrototypeId, Transform};
+use super::properties::{CacheOutcome, PropertyCache, PropertyConfig, RadiativeProperties, content_hashes};
+use super::InstancingError;
+use crate::geom::{Aabb, DVec3, Poly};
+use crate::hierarchy::{ElementId, Hierarchy};
+use crate::pipeline;
+use crate::refine::{BfHand, BfParams};
+use crate::scene::{Material, SceneBuilder, shapes::box_faces};
+use std::collections::HashMap;
+use std::io::{Seek, Write};
+use std::path::{Path, PathBuf};
+
+/// Largest reflectance given to a proxy (the builder requires ρ < 1).
+pub const MAX_PROXY_REFLECTANCE: f64 = 0.99;
+/// Smallest extent of a proxy box on any axis, relative to its diagonal (flat prototypes such as a
+/// single leaf still get a box with six faces of positive area).
+pub const MIN_PROXY_EXTENT_REL: f64 = 1e-3;
+
+/// Settings of [`solve_instanced`].
+#[derive(Clone, Debug)]
+pub struct InstancedConfig {
+    /// Settings of every local solve.
+    pub pipeline: pipeline::Config,
+    /// BF oracle parameters of every local solve.
+    pub bf: BfParams,
+    /// Sampling of the prototypes' properties.
+    pub properties: PropertyConfig,
+    /// Folder of the property cache; `None` computes properties in memory only.
+    pub cache_dir: Option<PathBuf>,
+    /// Instances of prototypes with more flattened polygons than this are opened in place.
+    pub max_closed_polygons: u64,
+    /// Rays per polygon gathering the light that arrived at an opened instance (rounded up to a
+    /// square number of strata).
+    pub incoming_rays: u32,
+}
+
+impl Default for InstancedConfig {
+    fn default() -> Self {
+        InstancedConfig {
+            pipeline: pipeline::Config::default(),
+            bf: BfParams::default(),
+            properties: PropertyConfig::default(),
+            cache_dir: None,
+            max_closed_polygons: 20_000,
+            incoming_rays: 64,
+        }
+    }
+}
+
+/// Figures of one instanced solve.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct InstancedStats {
+    /// Local problems solved.
+    pub local_solves: u64,
+    /// Flattened polygons streamed to the sink.
+    pub polygons_out: u64,
+    /// Leaf elements streamed.
+    pub leaves_out: u64,
+    /// Links summed over local problems.
+    pub links: u64,
+    /// Most input polygons in one local problem (own + proxy faces).
+    pub max_local_polygons: usize,
+    /// Most links in one local problem.
+    pub max_local_links: u64,
+    /// Prototype properties read from the cache.
+    pub cache_hits: u64,
+    /// Prototype properties computed.
+    pub cache_computed: u64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Receives finished polygons, in flattening order of each local problem (not globally sorted).
+pub trait RadiositySink {
+    /// Flattened polygon `flat_index` (its index in [`super::flatten`] with two-sided pairs), of
+    /// scene material `material`, finished: its leaf elements and their radiosity (W/m², RGB).
+    fn polygon(&mut self, flat_index: u64, material: u32, leaves: &[(Poly, [f64; 3])]) -> Result<(), InstancingError>;
+}
+
+/// Keeps the area-weighted mean radiosity of every flattened polygon (memory linear in the
+/// polygons: for comparisons with the full solve, not for large scenes).
+#[derive(Clone, Debug, Default)]
+pub struct PolygonMeans {
+    /// Mean radiosity by flattened index (zero until received).
+    pub radiosity: Vec<[f64; 3]>,
+    /// Area by flattened index.
+    pub area: Vec<f64>,
+}
+
+impl RadiositySink for PolygonMeans {
+    fn polygon(&mut self, flat_index: u64, _material: u32, leaves: &[(Poly, [f64; 3])]) -> Result<(), InstancingError> {
+        let i = flat_index as usize;
+        if self.radiosity.len() <= i {
+            self.radiosity.resize(i + 1, [0.0; 3]);
+            self.area.resize(i + 1, 0.0);
+        }
+        let (mut acc, mut area) = ([0.0; 3], 0.0);
+        for (p, b) in leaves {
+            let a = p.area();
+            for c in 0..3 {
+                acc[c] += a * b[c];
+            }
+            area += a;
+        }
+        self.radiosity[i] = acc.map(|x| if area > 0.0 { x / area } else { 0.0 });
+        self.area[i] = area;
+        Ok(())
+    }
+}
+
+/// Streams leaf elements to an ASCII PLY file (vertices with radiosity as `float r g b`), with
+/// constant memory: faces go to a side file that is appended when [`PlyStream::finish`] is called.
+pub struct PlyStream {
+    path: PathBuf,
+    file: std::io::BufWriter<std::fs::File>,
+    faces_path: PathBuf,
+    faces: std::io::BufWriter<std::fs::File>,
+    n_vertices: u64,
+    n_faces: u64,
+}
+
+/// Width of the vertex and face counts in the PLY header, patched in place at the end.
+const PLY_COUNT_WIDTH: usize = 12;
+
+impl PlyStream {
+    /// Creates `path` (and a `.faces` side file next to it).
+    pub fn create(path: &Path) -> Result<PlyStream, InstancingError> {
+        let io = |p: &Path, e| InstancingError::io(p, "cannot write file", e);
+        let mut file = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| io(path, e))?);
+        let faces_path = path.with_extension("ply.faces");
+        let faces = std::io::BufWriter::new(std::fs::File::create(&faces_path).map_err(|e| io(&faces_path, e))?);
+        write!(
+            file,
+            "ply\nformat ascii 1.0\nelement vertex {:0w$}\nproperty double x\nproperty double y\nproperty double z\nproperty float r\nproperty float g\nproperty float b\nelement face {:0w$}\nproperty list uchar int vertex_indices\nend_header\n",
+            0,
+            0,
+            w = PLY_COUNT_WIDTH
+        )
+        .map_err(|e| io(path, e))?;
+        Ok(PlyStream { path: path.to_owned(), file, faces_path, faces, n_vertices: 0, n_faces: 0 })
+    }
+
+    /// Appends the faces, patches the counts and removes the side file.
+    pub fn finish(self) -> Result<(), InstancingError> {
+        let PlyStream { path, file, faces_path, faces, n_vertices, n_faces } = self;
+        let io = |p: &Path, e| InstancingError::io(p, "cannot write file", e);
+        drop(faces.into_inner().map_err(|e| io(&faces_path, e.into_error()))?);
+        let mut file = file.into_inner().map_err(|e| io(&path, e.into_error()))?;
+        let mut side = std::fs::File::open(&faces_path).map_err(|e| io(&faces_path, e))?;
+        std::io::copy(&mut side, &mut file).map_err(|e| io(&path, e))?;
+        let header = format!("ply\nformat ascii 1.0\nelement vertex {:0w$}\n", n_vertices, w = PLY_COUNT_WIDTH);
+        file.seek(std::io::SeekFrom::Start(0)).map_err(|e| io(&path, e))?;
+        file.write_all(header.as_bytes()).map_err(|e| io(&path, e))?;
+        let offset = header.len() + "property double x\nproperty double y\nproperty double z\nproperty float r\nproperty float g\nproperty float b\n".len();
+        file.seek(std::io::SeekFrom::Start(offset as u64)).map_err(|e| io(&path, e))?;
+        file.write_all(format!("element face {:0w$}\n", n_faces, w = PLY_COUNT_WIDTH).as_bytes()).map_err(|e| io(&path, e))?;
+        let _ = std::fs::remove_file(&faces_path);
+        Ok(())
+    }
+}
+
+impl RadiositySink for PlyStream {
+    fn polygon(&mut self, _flat_index: u64, _material: u32, leaves: &[(Poly, [f64; 3])]) -> Result<(), InstancingError> {
+        let io = |p: &Path, e| InstancingError::io(p, "cannot write file", e);
+        for (p, b) in leaves {
+            let vs = p.vertices();
+            for v in vs {
+                writeln!(self.file, "{} {} {} {} {} {}", v.x, v.y, v.z, b[0] as f32, b[1] as f32, b[2] as f32).map_err(|e| io(&self.path, e))?;
+            }
+            write!(self.faces, "{}", vs.len()).map_err(|e| io(&self.faces_path, e))?;
+            for k in 0..vs.len() as u64 {
+                write!(self.faces, " {}", self.n_vertices + k).map_err(|e| io(&self.faces_path, e))?;
+            }
+            writeln!(self.faces).map_err(|e| io(&self.faces_path, e))?;
+            self.n_vertices += vs.len() as u64;
+            self.n_faces += 1;
+        }
+        Ok(())
+    }
+}
+
+/// A closed instance's stand-in, per prototype.
+#[derive(Clone, Copy, Debug)]
+struct Proxy {
+    /// Shrunk local box.
+    shrunk: Aabb,
+    /// Mean escape albedo.
+    albedo: [f64; 3],
+}
+
+/// An instance waiting to be opened.
+struct Task {
+    prototype: PrototypeId,
+    transform: Transform,
+    flat_base: u64,
+    /// Irradiance received by the 6 proxy faces (order of [`box_faces`]); `None` at the top.
+    incoming: Option<[[f64; 3]; 6]>,
+}
+
+/// What a polygon of a local problem stands for.
+#[derive(Clone, Copy)]
+enum Role {
+    Own { flat_index: u64, material: u32 },
+    ProxyFace { slot: usize, face: usize },
+}
+
+/// Solves `scene` depth-first with instances (see the module docs), streaming every finished
+/// flattened polygon to `sink`.
+pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn RadiositySink) -> Result<InstancedStats, InstancingError> {
+    let t0 = std::time::Instant::now();
+    scene.validate()?;
+    let counts = scene.flattened_counts(true);
+    let bounds = scene.local_bounds();
+    let hashes = content_hashes(scene);
+    let cache = config.cache_dir.as_deref().map(PropertyCache::new);
+    let mut proxies: HashMap<PrototypeId, Proxy> = HashMap::new();
+    let mut stats = InstancedStats::default();
+    let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, incoming: None }];
+    // The BF threshold is relative to the largest emission of the problem solved; a local problem's
+    // largest emission is often a wall's, far below the scene's lights, so its threshold is rescaled
+    // to stay relative to the scene's largest emission (the full solve's criterion).
+    let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
+    while let Some(task) = stack.pop() {
+        // Gather the level: own polygons of the task and of instances opened in place, and the
+        // closed instances.
+        let mut own: Vec<(Poly, u32, u64)> = Vec::new();
+        let mut closed: Vec<(PrototypeId, Transform, u64)> = Vec::new();
+        let mut pending = vec![(task.prototype, task.transform, task.flat_base)];
+        while let Some((pid, t, base)) = pending.pop() {
+            let p = scene.prototype(pid);
+            let mut k = base;
+            for q in &p.polygons {
+                own.push((t.poly(&q.poly), q.material, k));
+                k += 1;
+                if scene.materials[q.material as usize].two_sided {
+                    k += 1;
+                }
+            }
+            let mut inline = Vec::new();
+            for inst in &p.instances {
+                let c = inst.prototype;
+                let child_t = t.then(&inst.transform);
+                if counts[c as usize] > config.max_closed_polygons || bounds[c as usize].is_empty() {
+                    inline.push((c, child_t, k));
+                } else {
+                    closed.push((c, child_t, k));
+                }
+                k += counts[c as usize];
+            }
+            for item in inline.into_iter().rev() {
+                pending.push(item);
+            }
+        }
+        own.sort_by_key(|o| o.2);
+
+        // Properties of the closed prototypes.
+        for &(c, _, _) in &closed {
+            if proxies.contains_key(&c) {
+                continue;
+            }
+            let props = match &cache {
+                Some(cache) => {
+                    let (props, outcome) = cache.get_or_compute(scene, &hashes, c, &config.properties)?;
+                    match outcome {
+                        CacheOutcome::Hit => stats.cache_hits += 1,
+                        CacheOutcome::Computed => stats.cache_computed += 1,
+                    }
+                    props
+                }
+                None => {
+                    stats.cache_computed += 1;
+                    super::properties::compute(scene, c, &config.properties)?
+                }
+            };
+            let _ = proxies.insert(c, proxy_of(&bounds[c as usize], &props));
+        }
+
+        // The local scene.
+        let mut b = SceneBuilder::new(&scene.path, &scene.prototype(task.prototype).name);
+        for m in &scene.materials {
+            let _ = b.material(m.clone())?;
+        }
+        let group = b.group("local");
+        let mut roles: Vec<Role> = Vec::new();
+        let add = |b: &mut SceneBuilder, roles: &mut Vec<Role>, poly: &Poly, material: u32, role: Role| -> Result<(), InstancingError> {
+            let before = b.n_polygons();
+            b.face(poly.vertices(), material, group, 0)?;
+            for _ in before..b.n_polygons() {
+                roles.push(role);
+            }
+            Ok(())
+        };
+        for &(poly, material, k) in &own {
+            add(&mut b, &mut roles, &poly, material, Role::Own { flat_index: k, material })?;
+            if scene.materials[material as usize].two_sided {
+                add(&mut b, &mut roles, &reversed(&poly), material, Role::Own { flat_index: k + 1, material })?;
+            }
+        }
+        let mut proxy_material: HashMap<PrototypeId, u32> = HashMap::new();
+        for (slot, &(c, t, _)) in closed.iter().enumerate() {
+            let proxy = proxies[&c];
+            let m = match proxy_material.get(&c) {
+                Some(&m) => m,
+                None => {
+                    let rho = proxy.albedo.map(|a| a.clamp(0.0, MAX_PROXY_REFLECTANCE));
+                    let m = b.material(Material::diffuse(&format!("(proxy {})", scene.prototype(c).name), rho))?;
+                    let _ = proxy_material.insert(c, m);
+                    m
+                }
+            };
+            for (face, (_, quad)) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false).into_iter().enumerate() {
+                let poly = t.poly(&Poly::quad(quad[0], quad[1], quad[2], quad[3]));
+                add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot, face })?;
+            }
+        }
+        let mut local = b.finish();
+        drop(own);
+        // The light that arrived at the instance: each polygon's irradiance from outside, by rays
+        // leaving it through the instance's box (blocked by the level's own geometry and proxies),
+        // each carrying the irradiance its exit face received in the parent. Its first reflection
+        // becomes the polygon's emission; the local solve adds every further interreflection.
+        let external = match &task.incoming {
+            Some(field) => incoming_irradiance(&local, &bounds[task.prototype as usize], &task.transform, field, config.incoming_rays, config.properties.seed),
+            None => Vec::new(),
+        };
+        if !external.is_empty() {
+            let mut materials = Vec::with_capacity(local.polygons.len());
+            for (i, p) in local.polygons.iter_mut().enumerate() {
+                let mut m = local.materials[p.material as usize].clone();
+                m.name = format!("p{i}");
+                m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * external[i][c]);
+                materials.push(m);
+                p.material = i as u32;
+            }
+            local.materials = materials;
+        }
+        let b_ref_local = local.polygons.iter().flat_map(|p| local.materials[p.material as usize].emission).fold(0.0, f64::max);
+        let mut bf = config.bf;
+        if b_ref_local > 0.0 && b_ref_scene > 0.0 {
+            bf.eps *= b_ref_scene / b_ref_local;
+        }
+        let oracle = BfHand { params: bf };
+        stats.max_local_polygons = stats.max_local_polygons.max(local.polygons.len());
+        if local.polygons.is_empty() {
+            continue;
+        }
+
+        // Solve, stream, keep only the proxies' irradiance.
+        let solved = pipeline::run(&local, &oracle, &config.pipeline, &|_| {});
+        stats.local_solves += 1;
+        stats.links += solved.links.len() as u64;
+        stats.max_local_links = stats.max_local_links.max(solved.links.len() as u64);
+        let h = &solved.hierarchy;
+        let mut proxy_irradiance = vec![[[0.0; 3]; 6]; closed.len()];
+        let mut leaves = Vec::new();
+        for (i, role) in roles.iter().enumerate() {
+            match *role {
+                Role::Own { flat_index, material } => {
+                    leaves.clear();
+                    collect_leaves(h, i as ElementId, &mut |e| {
+                        if let Some(p) = h.get(e).poly() {
+                            leaves.push((*p, solved.solution.radiosity[e as usize]));
+                        }
+                    });
+                    stats.leaves_out += leaves.len() as u64;
+                    stats.polygons_out += 1;
+                    sink.polygon(flat_index, material, &leaves)?;
+                }
+                Role::ProxyFace { slot, face } => {
+                    let (mut acc, mut area) = ([0.0; 3], 0.0);
+                    collect_leaves(h, i as ElementId, &mut |e| {
+                        let a = h.get(e).area;
+                        let irr = solved.solution.irradiance[e as usize];
+                        for c in 0..3 {
+                            acc[c] += a * irr[c];
+                        }
+                        area += a;
+                    });
+                    let ext = external.get(i).copied().unwrap_or([0.0; 3]);
+                    proxy_irradiance[slot][face] = std::array::from_fn(|c| ext[c] + if area > 0.0 { acc[c] / area } else { 0.0 });
+                }
+            }
+        }
+        drop(solved);
+        for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
+            stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(proxy_irradiance[slot]) });
+        }
+    }
+    stats.seconds = t0.elapsed().as_secs_f64();
+    Ok(stats)
+}
+
+/// Irradiance from outside of every polygon of `local` (see the module docs). `lb` is the opened
+/// prototype's local box, `t` its placement, `field` the irradiance received by its proxy's faces.
+fn incoming_irradiance(local: &crate::scene::Scene, lb: &Aabb, t: &Transform, field: &[[f64; 3]; 6], rays: u32, seed: u64) -> Vec<[f64; 3]> {
+    use rayon::prelude::*;
+    let caster = crate::visibility::RayCaster::new(local);
+    let inv = t.matrix.inverse();
+    let diag = t.aabb(lb).diagonal().max(f64::MIN_POSITIVE);
+    let k = f64::from(rays.max(1)).sqrt().ceil() as u32;
+    local
+        .polygons
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let n = p.poly.normal();
+            let mut rng = crate::visibility::Rng::for_link(seed, i as u32, 0x1C0);
+            let mut acc = [0.0; 3];
+            for s in 0..k * k {
+                let (a, b) = ((f64::from(s % k) + rng.next_f64()) / f64::from(k), (f64::from(s / k) + rng.next_f64()) / f64::from(k));
+                let x = p.poly.sample(rng.next_f64(), rng.next_f64()) + n * (super::properties::RAY_OFFSET_REL * diag);
+                let d = super::properties::cosine_dir_from(n, a, b);
+                if super::properties::cast(&caster, x, d).is_none() {
+                    let face = exit_face(lb, inv.transform_point3(x), inv.transform_vector3(d));
+                    for c in 0..3 {
+                        acc[c] += field[face][c];
+                    }
+                }
+            }
+            acc.map(|v| v / f64::from(k * k))
+        })
+        .collect()
+}
+
+/// The face (order of [`box_faces`]: x−, x+, y−, y+, z−, z+) through which the ray `o + t·d` leaves
+/// the box `b`.
+fn exit_face(b: &Aabb, o: DVec3, d: DVec3) -> usize {
+    let mut best = (0usize, f64::INFINITY);
+    for a in 0..3 {
+        if d[a] == 0.0 {
+            continue;
+        }
+        let (plane, face) = if d[a] > 0.0 { (b.max[a], 2 * a + 1) } else { (b.min[a], 2 * a) };
+        let t = (plane - o[a]) / d[a];
+        if t < best.1 {
+            best = (face, t);
+        }
+    }
+    best.0
+}
+
+fn proxy_of(local: &Aabb, props: &RadiativeProperties) -> Proxy {
+    let c = local.center();
+    let min_extent = MIN_PROXY_EXTENT_REL * local.diagonal().max(f64::MIN_POSITIVE);
+    let half = (0.5 * local.extent()).max(DVec3::splat(0.5 * min_extent));
+    let s = (1.0 - props.mean_transmittance()).clamp(0.0, 1.0).sqrt().max(MIN_PROXY_EXTENT_REL);
+    Proxy { shrunk: Aabb { min: c - half * s, max: c + half * s }, albedo: props.mean_albedo() }
+}
+
+/// Calls `f` on every leaf below `e`.
+fn collect_leaves(h: &Hierarchy, e: ElementId, f: &mut dyn FnMut(ElementId)) {
+    let mut stack = vec![e];
+    while let Some(x) = stack.pop() {
+        let kids = h.children_of(x);
+        if kids.is_empty() {
+            f(x);
+        } else {
+            stack.extend_from_slice(kids);
+        }
+    }
+}
+
+/// The same scene solved fully: flattened (two-sided polygons as pairs) and given to
+/// [`pipeline::run`]; the per-polygon mean radiosity is returned in flattening order, with the
+/// solve's link count.
+pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(PolygonMeans, u64), InstancingError> {
+    let flat = super::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
+    let solved = pipeline::run(&flat, &BfHand { params: config.bf }, &config.pipeline, &|_| {});
+    let mut means = PolygonMeans::default();
+    let mut leaves = Vec::new();
+    for i in 0..flat.polygons.len() {
+        leaves.clear();
+        collect_leaves(&solved.hierarchy, i as ElementId, &mut |e| {
+            if let Some(p) = solved.hierarchy.get(e).poly() {
+                leaves.push((*p, solved.solution.radiosity[e as usize]));
+            }
+        });
+        means.polygon(i as u64, flat.polygons[i].material, &leaves)?;
+    }
+    Ok((means, solved.links.len() as u64))
+}
+
+/// Error of `approx` against `reference`, per polygon and channel, as a fraction of the largest
+/// radiosity of `reference`: `(max error, area-weighted mean error)`.
+#[must_use]
+pub fn relative_error(reference: &PolygonMeans, approx: &PolygonMeans) -> (f64, f64) {
+    let b_max = reference.radiosity.iter().flat_map(|b| b.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    let (mut worst, mut acc, mut area) = (0.0f64, 0.0, 0.0);
+    for (i, r) in reference.radiosity.iter().enumerate() {
+        let a = approx.radiosity.get(i).copied().unwrap_or([0.0; 3]);
+        let e = (0..3).map(|c| (r[c] - a[c]).abs()).fold(0.0, f64::max);
+        worst = worst.max(e);
+        let w = reference.area.get(i).copied().unwrap_or(0.0);
+        acc += w * e;
+        area += w;
+    }
+    (worst / b_max, if area > 0.0 { acc / area / b_max } else { 0.0 })
+}
+
+/// Peak resident set size of this process in bytes (Linux `VmHWM`), when available.
+#[must_use]
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}

@@ -1,0 +1,102 @@
+//! The oracles a front end can name (`radiosity solve --oracle NAME`, `radiosity oracle list`):
+//! the BF oracle in its three releases, and any graph file (a path ending in `.toml`).
+
+use super::bf::{BF_TOML, BfFlat, BfFlatParams};
+use super::runtime::{DagOracle, load_graph, parse_graph};
+use super::{NoProbe, ParamError, Recorder, TraceStep, check_param, param_list};
+use crate::pipeline::{self, Config};
+use crate::refine::{BfHand, BfParams, Oracle};
+use crate::scene::Scene;
+use oracle_graph::Graph;
+use std::path::Path;
+
+/// A named oracle: its name, its release, and one line about it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OracleInfo {
+    /// Name on the command line.
+    pub name: &'static str,
+    /// `hand`, `flat` (`oracle!`) or `dag` (runtime).
+    pub release: &'static str,
+    /// One line.
+    pub doc: &'static str,
+}
+
+/// The built-in named oracles.
+pub const ORACLES: &[OracleInfo] = &[
+    OracleInfo { name: "bf", release: "flat", doc: "classic BF refiner compiled by `oracle!`" },
+    OracleInfo { name: "bf-dag", release: "dag", doc: "classic BF refiner interpreted by the DAG runtime" },
+    OracleInfo { name: "bf-hand", release: "hand", doc: "classic BF refiner written by hand (the baseline)" },
+];
+
+/// Why a name did not give an oracle.
+#[derive(Debug, thiserror::Error)]
+pub enum RegistryError {
+    /// Neither a built-in name nor a graph file.
+    #[error("unknown oracle `{0}` (oracles: bf, bf-dag, bf-hand, or a graph file `*.toml`)")]
+    Unknown(String),
+    /// A parameter was rejected.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// The graph file was rejected.
+    #[error(transparent)]
+    File(#[from] super::runtime::GraphFileError),
+    /// The graph could not be compiled.
+    #[error(transparent)]
+    Runtime(#[from] super::runtime::RuntimeError),
+}
+
+/// The decision graph of oracle `name` (a built-in name or a graph file path).
+pub fn graph(name: &str) -> Result<Graph, RegistryError> {
+    match name {
+        "bf" | "bf-hand" => Ok(BfFlat::<NoProbe>::GRAPH),
+        "bf-dag" => Ok(parse_graph(BF_TOML, Path::new("<bf>"))?),
+        path if path.ends_with(".toml") => Ok(load_graph(Path::new(path))?),
+        other => Err(RegistryError::Unknown(other.to_owned())),
+    }
+}
+
+/// The parameters of oracle `name` as `name: type = default in [min, max]`, comma-separated.
+pub fn params(name: &str) -> Result<String, RegistryError> {
+    Ok(param_list(&graph(name)?))
+}
+
+/// Oracle `name` with parameters `params` (`(name, value)`, checked against the declared ranges).
+pub fn oracle(name: &str, params: &[(String, f64)]) -> Result<Box<dyn Oracle>, RegistryError> {
+    let g = graph(name)?;
+    for (p, v) in params {
+        check_param(&g, p, *v)?;
+    }
+    match name {
+        "bf" => {
+            let mut p = BfFlatParams::default();
+            for (n, v) in params {
+                p.set(n, *v)?;
+            }
+            Ok(Box::new(BfFlat::new(p)))
+        }
+        "bf-hand" => {
+            let mut p = BfParams::default();
+            for (n, v) in params {
+                match n.as_str() {
+                    "eps" => p.eps = *v,
+                    // The hand-written oracle has no `min_area`: only the default (0) is accepted.
+                    _ if *v == 0.0 => {}
+                    _ => return Err(ParamError { message: format!("parameter `{n}` is not supported by `bf-hand`") }.into()),
+                }
+            }
+            Ok(Box::new(BfHand { params: p }))
+        }
+        _ => Ok(Box::new(DagOracle::new(g, params)?)),
+    }
+}
+
+/// What `radiosity oracle explain` shows: the execution track of `emitter → receiver` (element ids)
+/// when `scene` is solved with the graph of oracle `name`, interpreted by the DAG runtime with a
+/// recorder (decisions are the same as the named release's). Empty when the pair is never asked.
+pub fn explain(name: &str, params: &[(String, f64)], scene: &Scene, config: &Config, emitter: u32, receiver: u32) -> Result<(Graph, Vec<TraceStep>), RegistryError> {
+    let g = graph(name)?;
+    let probe = Recorder::new(g.nodes.len()).tracing(emitter, receiver);
+    let dag = DagOracle::with_probe(g.clone(), params, Vec::new(), probe)?;
+    let _ = pipeline::run(scene, &dag, config, &|_| {});
+    Ok((g, dag.probe().trace()))
+}

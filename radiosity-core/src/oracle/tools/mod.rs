@@ -1,0 +1,12 @@
+//! The built-in tools. Their names, answers and arguments are listed in
+//! [`oracle_graph::catalogue`]; a test checks the two agree.
+
+mod command;
+mod energy;
+mod geometry;
+mod visibility;
+
+pub use command::{Done, Mark, PreciseFormFactor, PreciseVisibility};
+pub use energy::{BfAbove, FfGradient, FfSpread, Irradiance, IrradianceChange};
+pub use geometry::{CanSubdivide, ClusterTooNear, Facing, Larger, NormalCone, PlanesIntersect, ProjectedAreaBelow, Side, Subdividable, YesNo, Cone};
+pub use visibility::{PROBABLE_BELOW_RAYS, REFERENCE_RAYS, RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};

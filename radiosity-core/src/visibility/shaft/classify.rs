@@ -1,0 +1,146 @@
+//! Shaft classification of a link, the entry point for the shaft oracle's tools: build the link's
+//! shaft, collect its candidate occluders (from the parent link's list when there is one), and
+//! decide whether the link is certainly invisible, certainly visible, or partial.
+
+use super::build::Shaft;
+use super::cull::may_intersect_obb;
+use super::objects::{BoundingVolume, ShaftObjects};
+use super::occlusion::{convex_polygon_occludes, plate_occludes, solid_occludes};
+use super::plane::{aabb_corners, min_dot_aabb};
+use crate::geom::DVec3;
+use crate::hierarchy::{ElementId, Hierarchy};
+
+/// Depth, relative to the shaft's diagonal, by which an object must reach into the shaft to count
+/// as a possible blocker for [`ShaftClass`]. Objects that only graze the shaft's boundary (a floor
+/// meeting a wall element's edge) stay in the candidate list but do not make a link partial: the
+/// segments they can block end within this distance of the shaft's boundary, which the ray caster
+/// leaves out as well (its end fractions).
+pub const GRAZE_REL_TOL: f64 = 1e-6;
+
+/// What a shaft says about a link's visibility.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShaftClass {
+    /// One candidate blocks every segment between the elements (conservative: never claimed when
+    /// some segment is unblocked).
+    Invisible,
+    /// No object reaches into the shaft: every segment is unblocked.
+    Visible,
+    /// Some objects reach into the shaft and none is known to block it all.
+    Partial {
+        /// Number of objects that reach into the shaft.
+        candidates: u32,
+    },
+}
+
+/// The result of [`classify`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShaftVerdict {
+    /// Invisible, visible or partial.
+    pub class: ShaftClass,
+    /// The link's candidate list, to be passed to its children's [`classify`] and to
+    /// [`super::visibility_among`]; sorted by object id. Contains every object that may meet the
+    /// shaft, except objects whose only polygons in the shaft are the link's own surfaces.
+    pub candidates: Vec<u32>,
+    /// The object that blocks the shaft, when invisible.
+    pub occluder: Option<u32>,
+}
+
+/// The shaft between two elements' bounding boxes.
+#[must_use]
+pub fn shaft_of(h: &Hierarchy, emitter: ElementId, receiver: ElementId) -> Shaft {
+    Shaft::new(&h.get(emitter).bounds, &h.get(receiver).bounds)
+}
+
+/// The vertices of an element's convex hull: a surface's polygon, or a cluster's 8 box corners.
+#[must_use]
+pub fn element_vertices(h: &Hierarchy, id: ElementId) -> Vec<DVec3> {
+    let e = h.get(id);
+    match e.poly() {
+        Some(p) => p.vertices().to_vec(),
+        None => aabb_corners(&e.bounds).to_vec(),
+    }
+}
+
+/// Classifies the link `emitter` → `receiver`. `parent_candidates` is the candidate list of a link
+/// whose shaft contains this one (the link it was subdivided from), or `None` to search the whole
+/// scene. Invisible only when a single candidate (a closed convex solid, or one polygon) blocks
+/// every segment between the two elements; visible only when no candidate reaches deeper than
+/// [`GRAZE_REL_TOL`] into the shaft.
+#[must_use]
+pub fn classify(objects: &ShaftObjects, h: &Hierarchy, emitter: ElementId, receiver: ElementId, parent_candidates: Option<&[u32]>) -> ShaftVerdict {
+    let shaft = shaft_of(h, emitter, receiver);
+    let mut candidates = objects.candidates(&shaft, parent_candidates);
+    // Polygons that are the link's own surfaces (kept by every descendant link of a surface).
+    let own: [Option<u32>; 2] = [h.get(emitter).polygon(), h.get(receiver).polygon()];
+    let is_own = |p: u32| own.contains(&Some(p));
+    let graze = GRAZE_REL_TOL * shaft.extent.diagonal();
+    let mut blocking: Vec<u32> = Vec::new();
+    candidates.retain(|&id| {
+        let polys = objects.polygons_of(id);
+        if polys.iter().any(|&p| is_own(p)) {
+            // The object's bounding volume holds a link surface: judge its other polygons one by one.
+            let reach = polys.iter().filter(|&&p| !is_own(p)).map(|&p| depth_into(&shaft, objects.polys[p as usize].vertices())).fold(f64::NEG_INFINITY, f64::max);
+            if reach >= -shaft.tol {
+                if reach > graze {
+                    blocking.push(id);
+                }
+                return true;
+            }
+            return false;
+        }
+        if reaches_deeper(objects, &shaft, id, graze) {
+            blocking.push(id);
+        }
+        true
+    });
+    if blocking.is_empty() {
+        return ShaftVerdict { class: ShaftClass::Visible, candidates, occluder: None };
+    }
+    let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
+    for &id in &blocking {
+        if occludes(objects, id, &pv, &qv, &own) {
+            return ShaftVerdict { class: ShaftClass::Invisible, candidates, occluder: Some(id) };
+        }
+    }
+    ShaftVerdict { class: ShaftClass::Partial { candidates: blocking.len() as u32 }, candidates, occluder: None }
+}
+
+/// Whether object `id` blocks every segment between the hulls of `p` and `q` on its own, as a closed
+/// convex solid, through one of its polygons, or through one of its merged plates (never using the
+/// `own` polygons, which the ray caster ignores). Conservative.
+#[must_use]
+pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: &[Option<u32>]) -> bool {
+    if objects.solid_of(id).is_some_and(|solid| solid_occludes(p, q, solid)) {
+        return true;
+    }
+    objects.polygons_of(id).iter().filter(|&&k| !own.contains(&Some(k))).any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
+        || objects
+            .merged_of(id)
+            .iter()
+            .filter(|m| !m.polygons.iter().any(|&k| own.contains(&Some(k))))
+            .any(|m| convex_polygon_occludes(p, q, &m.vertices))
+}
+
+/// How deep the hull of `points` reaches into the shaft: the smallest, over the shaft's planes, of
+/// how far the deepest point lies inside that plane (negative when outside some plane).
+fn depth_into(shaft: &Shaft, points: &[DVec3]) -> f64 {
+    shaft.planes().map(|pl| pl.offset - pl.min_over_points(points)).fold(f64::INFINITY, f64::min)
+}
+
+/// Whether the object's bounding volume reaches deeper than `graze` into the shaft on every plane.
+fn reaches_deeper(objects: &ShaftObjects, shaft: &Shaft, id: u32, graze: f64) -> bool {
+    let o = &objects.objects[id as usize];
+    let box_depth = shaft.planes().map(|pl| pl.offset - min_dot_aabb(pl.normal, &o.aabb)).fold(f64::INFINITY, f64::min);
+    if box_depth <= graze {
+        return false;
+    }
+    match objects.volume {
+        BoundingVolume::Aabb => true,
+        BoundingVolume::Obb => shaft.planes().all(|pl| pl.offset - o.obb.min_along(&pl) > graze),
+        BoundingVolume::Hull => match objects.hull_of(id) {
+            Some(points) => depth_into(shaft, points) > graze,
+            None => may_intersect_obb(shaft, &o.obb) && shaft.planes().all(|pl| pl.offset - o.obb.min_along(&pl) > graze),
+        },
+    }
+}
+

@@ -1,0 +1,209 @@
+//! Ray casting restricted to a shaft's candidate occluders: the visibility fraction of a link from
+//! jittered stratified segments, tested in `f64` only against the candidates' polygons.
+//!
+//! The samples are drawn and weighted exactly as [`crate::visibility::RayCaster::visibility`] does
+//! (same generator, strata, order and kernel weights), so with a complete candidate list both give
+//! the same estimate up to the `f32` rounding of the global caster.
+
+use super::classify::shaft_of;
+use super::objects::ShaftObjects;
+use crate::geom::{Aabb, DVec3, Poly};
+use crate::hierarchy::{ElementId, Hierarchy};
+use crate::visibility::{Rng, VisibilityConfig};
+
+/// Fraction of the segment length left out at each end, as in the global ray caster, so that the
+/// endpoints' neighbours that touch them (a wall meeting the floor) do not occlude.
+pub const SEGMENT_END_EPS: f64 = 1e-5;
+
+/// Regularisation of the kernel weights of visibility samples, relative to the squared sum of the
+/// two elements' radii; the same value as the global caster's (its constant is private to it).
+pub const KERNEL_REGULARISATION: f64 = 1e-4;
+
+/// Whether the segment `a`–`b` (without its end fractions [`SEGMENT_END_EPS`]) misses every
+/// polygon of the `candidates` objects other than `skip_a` and `skip_b`.
+#[must_use]
+pub fn segment_clear_among(objects: &ShaftObjects, candidates: &[u32], a: DVec3, b: DVec3, skip_a: u32, skip_b: u32) -> bool {
+    let d = b - a;
+    let inv = d.recip();
+    for &id in candidates {
+        let o = &objects.objects[id as usize];
+        if !segment_meets_box(a, inv, &o.aabb) {
+            continue;
+        }
+        for &poly_idx in objects.polygons_of(id) {
+            if poly_idx == skip_a || poly_idx == skip_b {
+                continue;
+            }
+            if segment_hits_polygon(a, d, &objects.polys[poly_idx as usize]) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Slab test of the segment `a + t d`, `t` in `[0, 1]`, against a box (`inv` = `1 / d` per axis);
+/// the box is widened by a relative margin so that rounding never misses a polygon on its face.
+fn segment_meets_box(a: DVec3, inv: DVec3, b: &Aabb) -> bool {
+    let pad = 1e-9 * b.diagonal() + f64::MIN_POSITIVE;
+    let (lo, hi) = (b.min - pad, b.max + pad);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for k in 0..3 {
+        if inv[k].is_infinite() {
+            if a[k] < lo[k] || a[k] > hi[k] {
+                return false;
+            }
+            continue;
+        }
+        let (x, y) = ((lo[k] - a[k]) * inv[k], (hi[k] - a[k]) * inv[k]);
+        t0 = t0.max(x.min(y));
+        t1 = t1.min(x.max(y));
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+/// Whether the segment `a + t d`, `t` in `[SEGMENT_END_EPS, 1 − SEGMENT_END_EPS]`, crosses the
+/// convex polygon (edges included).
+fn segment_hits_polygon(a: DVec3, d: DVec3, poly: &Poly) -> bool {
+    let n = poly.area_vector();
+    let denom = n.dot(d);
+    if denom == 0.0 {
+        return false;
+    }
+    let t = n.dot(poly.v[0] - a) / denom;
+    if !(SEGMENT_END_EPS..=1.0 - SEGMENT_END_EPS).contains(&t) {
+        return false;
+    }
+    let x = a + d * t;
+    let vs = poly.vertices();
+    (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(x - vs[k]).dot(n) >= 0.0)
+}
+
+/// A polygon ready for many segment tests: its plane and in-plane outward edge planes.
+struct PreparedPolygon {
+    polygon: u32,
+    normal: DVec3,
+    offset: f64,
+    edges: [(DVec3, f64); 4],
+    n_edges: usize,
+}
+
+impl PreparedPolygon {
+    fn new(poly: &Poly, polygon: u32) -> Option<PreparedPolygon> {
+        let normal = poly.area_vector().try_normalize()?;
+        let vs = poly.vertices();
+        let mut edges = [(DVec3::ZERO, 0.0); 4];
+        for k in 0..vs.len() {
+            let e = (vs[(k + 1) % vs.len()] - vs[k]).cross(normal);
+            edges[k] = (e, e.dot(vs[k]));
+        }
+        Some(PreparedPolygon { polygon, normal, offset: normal.dot(vs[0]), edges, n_edges: vs.len() })
+    }
+
+    /// Same contract as [`segment_hits_polygon`] for the segment `a`–`b`.
+    #[inline]
+    fn hit_by(&self, a: DVec3, b: DVec3) -> bool {
+        let sa = self.normal.dot(a) - self.offset;
+        let sb = self.normal.dot(b) - self.offset;
+        if (sa > 0.0) == (sb > 0.0) || sa == sb {
+            return false;
+        }
+        let t = sa / (sa - sb);
+        if !(SEGMENT_END_EPS..=1.0 - SEGMENT_END_EPS).contains(&t) {
+            return false;
+        }
+        let x = a + (b - a) * t;
+        self.edges[..self.n_edges].iter().all(|&(e, off)| e.dot(x) <= off)
+    }
+}
+
+/// Visibility of the link `source` → `receiver` from `config.rays` stratified segments, tested only
+/// against the `candidates` objects (a shaft's list): the clear segments' share of the transfer
+/// kernel `cosθ_s cosθ_r / r²` (regularised), as the global caster weighs them, or the plain clear
+/// fraction when no segment carries weight. Returns the visibility and the number of segments cast. Deterministic for a given seed; correct when `candidates` holds every
+/// object that meets the link's shaft (as [`ShaftObjects::candidates`] guarantees).
+///
+/// Before casting, the candidates are narrowed to their polygons whose vertices reach the link's
+/// shaft (exact per shaft plane), largest first so that blocked segments stop early.
+#[must_use]
+pub fn visibility_among(
+    objects: &ShaftObjects,
+    h: &Hierarchy,
+    source: ElementId,
+    receiver: ElementId,
+    candidates: &[u32],
+    config: &VisibilityConfig,
+) -> (f64, u32) {
+    let shaft = shaft_of(h, source, receiver);
+    let own = [h.get(source).polygon(), h.get(receiver).polygon()];
+    let mut polys: Vec<(f64, PreparedPolygon)> = Vec::new();
+    for &id in candidates {
+        for &k in objects.polygons_of(id) {
+            let poly = &objects.polys[k as usize];
+            if own.contains(&Some(k)) || !shaft.may_intersect_points(poly.vertices()) {
+                continue;
+            }
+            if let Some(prepared) = PreparedPolygon::new(poly, k) {
+                polys.push((poly.area(), prepared));
+            }
+        }
+    }
+    polys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.polygon.cmp(&b.1.polygon)));
+    let n = config.rays.max(1) as usize;
+    let mut rng = Rng::for_link(config.seed, source, receiver);
+    let k = (n as f64).sqrt().ceil() as usize;
+    let mut order: Vec<u32> = (0..(k * k) as u32).collect();
+    for i in (1..order.len()).rev() {
+        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    let reg = KERNEL_REGULARISATION * (h.get(source).radius + h.get(receiver).radius).powi(2);
+    let (mut clear, mut w_clear, mut w_all) = (0usize, 0.0f64, 0.0f64);
+    for i in 0..n {
+        let cell_s = i % (k * k);
+        let cell_r = order[i % (k * k)] as usize;
+        let su = ((cell_s % k) as f64 + rng.next_f64()) / k as f64;
+        let sv = ((cell_s / k) as f64 + rng.next_f64()) / k as f64;
+        let ru = ((cell_r % k) as f64 + rng.next_f64()) / k as f64;
+        let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
+        let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
+        let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
+        let d = pb - pa;
+        let r2 = d.length_squared();
+        let (na, nb) = (h.get(poly_a).normal, h.get(poly_b).normal);
+        let w = (na.dot(d).max(0.0) * (-nb.dot(d)).max(0.0)) / (r2 * (r2 + reg));
+        let blocked = polys.iter().any(|(_, p)| p.polygon != poly_a && p.polygon != poly_b && p.hit_by(pa, pb));
+        if !blocked {
+            clear += 1;
+            w_clear += w;
+        }
+        w_all += w;
+    }
+    let v = if w_all > 0.0 && w_all.is_finite() { w_clear / w_all } else { clear as f64 / n as f64 };
+    (v, n as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polygon_hits_respect_edges_and_ends() {
+        let q = Poly::quad(DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y);
+        let d = DVec3::new(0.0, 0.0, -2.0);
+        assert!(segment_hits_polygon(DVec3::new(0.5, 0.5, 1.0), d, &q));
+        assert!(!segment_hits_polygon(DVec3::new(1.5, 0.5, 1.0), d, &q));
+        // Ends on the polygon are left out.
+        assert!(!segment_hits_polygon(DVec3::new(0.5, 0.5, 2.0), d, &q));
+        assert!(segment_meets_box(DVec3::new(0.5, 0.5, 1.0), d.recip(), &Aabb::from_points(q.vertices())));
+        // The prepared test agrees with the plain one.
+        let p = PreparedPolygon::new(&q, 0).unwrap();
+        for (a, b) in [((0.5, 0.5, 1.0), (0.5, 0.5, -1.0)), ((1.5, 0.5, 1.0), (1.5, 0.5, -1.0)), ((0.5, 0.5, 2.0), (0.5, 0.5, 0.0)), ((0.0, 0.0, 1.0), (1.0, 1.0, -1.0))] {
+            let (a, b) = (DVec3::from(a), DVec3::from(b));
+            assert_eq!(p.hit_by(a, b), segment_hits_polygon(a, b - a, &q), "{a} -> {b}");
+        }
+    }
+}

@@ -1,0 +1,11 @@
+use radiosity::oracle;
+
+oracle! {
+    crate = ::radiosity;
+    oracle Hollow {
+        start => a;
+        a: Facing {}
+    }
+}
+
+fn main() {}
