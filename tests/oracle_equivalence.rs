@@ -32,8 +32,8 @@ fn check(scene: &Scene, eps: f64, min_area_rel: f64) {
 fn three_releases_agree_on_the_cornell_box() {
     // The default smallest element (the box has few polygons, so refinement goes deep).
     let min_area_rel = Config::default().build.min_area_rel;
+    check(&radiosity::scene::cornell_box(), 0.002, min_area_rel);
     check(&radiosity::scene::cornell_box(), 0.01, min_area_rel);
-    check(&radiosity::scene::cornell_box(), 0.05, min_area_rel);
 }
 
 #[test]

@@ -112,14 +112,14 @@ fn statistics_and_trace_of_an_instrumented_run() {
     assert_eq!(stats[0].node, "facing");
     assert_eq!(stats[0].calls, solved.refine_stats.oracle_calls, "the start node sees every oracle call");
     let facing_yes = stats[0].answers.iter().find(|(a, _)| a == "Yes").map_or(0, |x| x.1);
-    assert_eq!(stats[1].calls, facing_yes, "`near` is reached exactly by facing's `Yes`");
+    assert_eq!(stats[1].calls, facing_yes, "`energy` is reached exactly by facing's `Yes`");
     assert!(format_stats(&stats).contains("facing"));
 
     let trace = dag.probe().trace();
     assert!(!trace.is_empty(), "the traced pair was evaluated");
     assert_eq!(trace[0].node, 0);
     let text = format_trace(&graph, &trace);
-    assert!(text.starts_with("facing: Facing -> Yes => near"), "{text}");
+    assert!(text.starts_with("facing: Facing -> Yes => energy"), "{text}");
     assert!(text.lines().last().is_some_and(|l| l.contains("=> link")), "the linked pair ends in `link`: {text}");
 }
 

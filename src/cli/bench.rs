@@ -11,6 +11,20 @@ use std::process::Command;
 pub enum BenchCommand {
     /// Full solves: elements, links, rays, time per phase and peak RSS per scene.
     Solve(SolveBenchArgs),
+    /// What leaving out unneeded machinery saves: each scene solved with and without the scene
+    /// analysis.
+    LeaveOut(LeaveOutArgs),
+}
+
+/// Arguments of `bench leave-out`.
+#[derive(clap::Args, Debug)]
+pub struct LeaveOutArgs {
+    /// Threshold.
+    #[arg(long, default_value_t = 0.05)]
+    pub eps: f64,
+    /// Print one JSON document instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `bench solve`.
@@ -29,6 +43,7 @@ pub struct SolveBenchArgs {
 pub fn run(which: BenchCommand) -> anyhow::Result<()> {
     match which {
         BenchCommand::Solve(args) => bench_solve(&args),
+        BenchCommand::LeaveOut(args) => bench_leave_out(&args),
     }
 }
 
@@ -159,4 +174,47 @@ fn print_row(scene: &str, s: &serde_json::Value) {
         f(&s["peak_rss_bytes"]) / 1e6,
         rp
     );
+}
+
+fn bench_leave_out(args: &LeaveOutArgs) -> anyhow::Result<()> {
+    use radiosity::geom::DVec3;
+    use radiosity::pipeline::{self, Config};
+    use radiosity::refine::{BfHand, BfParams};
+    use std::time::Instant;
+    anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
+    let scenes = vec![
+        ("furnace box (convex)", radiosity::scene::shapes::furnace_box(DVec3::new(1.0, 1.3, 0.8), 0.8, 1.0)),
+        ("cornell box", radiosity::scene::cornell_box()),
+    ];
+    let oracle = BfHand { params: BfParams { eps: args.eps } };
+    let mut rows = Vec::new();
+    for (name, scene) in &scenes {
+        let mut timed = Vec::new();
+        for analyse in [false, true] {
+            let mut config = Config::default();
+            config.analyse = analyse;
+            config.build.min_area_rel = 1e-4;
+            let t = Instant::now();
+            let solved = pipeline::run(scene, &oracle, &config, &|_| {});
+            timed.push((t.elapsed().as_secs_f64(), solved.rays, solved.left_out.clone(), solved.links.len()));
+        }
+        rows.push((name, timed));
+    }
+    if args.json {
+        let doc: Vec<serde_json::Value> = rows
+            .iter()
+            .map(|(name, t)| {
+                serde_json::json!({"scene": name, "full_s": t[0].0, "full_rays": t[0].1, "specialised_s": t[1].0,
+                    "specialised_rays": t[1].1, "left_out": t[1].2, "links": t[1].3})
+            })
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(());
+    }
+    println!("{:<22} {:>8} {:>10} {:>10} {:>10} {:>7}  left out", "scene", "links", "full_s", "special_s", "rays_full", "ratio");
+    for (name, t) in &rows {
+        let left = if t[1].2.is_empty() { "nothing".to_string() } else { t[1].2.join("; ") };
+        println!("{:<22} {:>8} {:>10.3} {:>10.3} {:>10} {:>7.2}  {}", name, t[1].3, t[0].0, t[1].0, t[0].1, t[0].0 / t[1].0, left);
+    }
+    Ok(())
 }

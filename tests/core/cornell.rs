@@ -59,7 +59,7 @@ fn symmetric_cornell_box_is_symmetric_with_colours_swapped() {
     b.quad("ceiling", ceiling(0., a, a, c), white);
     b.quad("ceiling", ceiling(c, 1., a, c), white);
     let scene = b.finish();
-    let solved = solve(&scene, 0.005, 1e-4);
+    let solved = solve(&scene, 0.001, 1e-4);
     let r = polygon_results(&solved.hierarchy, &solved.solution);
     let (floor, back, left, right, ceil_w, ceil_e) = (0, 1, 2, 3, 7, 8);
     let check = |what: &str, x: f64, y: f64| {

@@ -1,7 +1,7 @@
 //! The classic BF oracle in its three releases: hand-written ([`crate::refine::BfHand`]), compiled
 //! by `oracle!` ([`BfFlat`]) and interpreted by the DAG runtime ([`bf_dag`], from [`BF_TOML`]).
 //! The three make the same decisions (the equivalence tests compare links and radiosity bit for
-//! bit): facing pairs only; link when `B_S · F_max ≤ eps · B_ref` unless a cluster is too near;
+//! bit): facing pairs only; link when `B_S · F_max ≤ eps · B_ref`;
 //! otherwise subdivide what can be, the larger element first.
 
 use super::runtime::{DagOracle, GraphFileError, parse_graph};
@@ -14,8 +14,7 @@ oracle_macros::oracle! {
     pub oracle BfFlat {
         params { eps: f64 = 0.01 in 0.0..=1.0, min_area: f64 = 0.0 in 0.0..=1e300 }
         start => facing;
-        facing: Facing { No => stop, Yes => near }
-        near: ClusterTooNear { Yes => size, No => energy }
+        facing: Facing { No => stop, Yes => energy }
         energy: BfAbove(eps) { No => link, Yes => size }
         size: CanSubdivide(min_area) {
             Neither => link,
@@ -48,12 +47,7 @@ max = 1e300
 [[node]]
 name = "facing"
 tool = "Facing"
-arms = [{ on = "No", to = "stop" }, { on = "Yes", to = "near" }]
-
-[[node]]
-name = "near"
-tool = "ClusterTooNear"
-arms = [{ on = "Yes", to = "size" }, { on = "No", to = "energy" }]
+arms = [{ on = "No", to = "stop" }, { on = "Yes", to = "energy" }]
 
 [[node]]
 name = "energy"

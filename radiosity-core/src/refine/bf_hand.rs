@@ -44,9 +44,11 @@ pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
     let f = ctx.form_factor_max();
     let b = ctx.emitter_radiosity();
     let (s, r) = (ctx.emitter_element(), ctx.receiver_element());
-    // Clusters must be well separated for the isotropic approximation to hold.
-    let near_cluster = (s.is_cluster() || r.is_cluster()) && (s.center - r.center).length() < 2.0 * (s.radius + r.radius);
-    if !near_cluster && b * f <= params.eps * ctx.services.b_ref {
+    // The cluster estimate is conservative (distance shortened by the bounding radii, full
+    // projected area), so a link it accepts carries at most eps·B_ref whatever the clusters'
+    // distance: near clusters are refined only when they matter. Forcing every near cluster pair
+    // down to surfaces made compact geometry (foliage) quadratic in its polygon count.
+    if b * f <= params.eps * ctx.services.b_ref {
         return Decision::Link;
     }
     let h = ctx.hierarchy();

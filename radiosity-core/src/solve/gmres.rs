@@ -126,7 +126,7 @@ mod tests {
                 y[i] = x[i] - rho * mean;
             }
         };
-        let cfg = SolveConfig { tolerance: 1e-12, max_iterations: 100, restart: 20 };
+        let cfg = SolveConfig { tolerance: 1e-10, max_iterations: 100, restart: 20 };
         let res = gmres(&apply, &b, vec![0.0; n], &cfg);
         let mean_b = b.iter().sum::<f64>() / n as f64;
         for i in 0..n {
