@@ -11,9 +11,26 @@ use std::process::Command;
 pub enum BenchCommand {
     /// Full solves: elements, links, rays, time per phase and peak RSS per scene.
     Solve(SolveBenchArgs),
+    /// The three BF releases (hand-written, DAG runtime, `oracle!`) side by side: refinement time
+    /// and ratio to hand-written, and whether links and radiosity are identical.
+    Oracle(OracleBenchArgs),
     /// What leaving out unneeded machinery saves: each scene solved with and without the scene
     /// analysis.
     LeaveOut(LeaveOutArgs),
+}
+
+/// Arguments of `bench oracle`.
+#[derive(clap::Args, Debug)]
+pub struct OracleBenchArgs {
+    /// Threshold.
+    #[arg(long, default_value_t = 0.01)]
+    pub eps: f64,
+    /// Runs per release (the fastest counts).
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+    /// Print one JSON document instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `bench leave-out`.
@@ -44,6 +61,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
     match which {
         BenchCommand::Solve(args) => bench_solve(&args),
         BenchCommand::LeaveOut(args) => bench_leave_out(&args),
+        BenchCommand::Oracle(args) => bench_oracle(&args),
     }
 }
 
@@ -216,5 +234,20 @@ fn bench_leave_out(args: &LeaveOutArgs) -> anyhow::Result<()> {
         let left = if t[1].2.is_empty() { "nothing".to_string() } else { t[1].2.join("; ") };
         println!("{:<22} {:>8} {:>10.3} {:>10.3} {:>10} {:>7.2}  {}", name, t[1].3, t[0].0, t[1].0, t[0].1, t[0].0 / t[1].0, left);
     }
+    Ok(())
+}
+
+fn bench_oracle(args: &OracleBenchArgs) -> anyhow::Result<()> {
+    use radiosity::oracle::{bench, scenes};
+    anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
+    anyhow::ensure!(args.repeats >= 1, "--repeats must be at least 1");
+    let config = bench::BenchConfig { eps: args.eps, repeats: args.repeats, ..bench::BenchConfig::default() };
+    let rows = bench::run(&scenes::bench_scenes(), &config);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        print!("{}", bench::format_table(&rows));
+    }
+    anyhow::ensure!(rows.iter().all(|r| r.identical), "the three releases disagree on some scene");
     Ok(())
 }

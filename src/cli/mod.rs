@@ -1,6 +1,8 @@
 //! Subcommands.
 
 mod bench;
+mod generate;
+mod oracle;
 mod progress;
 mod solve;
 mod sweep;
@@ -24,6 +26,16 @@ enum Command {
     /// Error against run time: solves with several oracles and thresholds, compares with a
     /// reference, writes sweep.csv and sweep.svg.
     Sweep(sweep::SweepArgs),
+    /// Procedural plants as instanced scenes (solve them with `radiosity solve DIR/tree.toml`).
+    Generate {
+        #[command(subcommand)]
+        which: generate::GenerateCommand,
+    },
+    /// Refinement oracles: list them, export their graphs, trace their decisions.
+    Oracle {
+        #[command(subcommand)]
+        which: oracle::OracleCommand,
+    },
     /// Benchmarks that print tables (and JSON with --json).
     Bench {
         #[command(subcommand)]
@@ -36,6 +48,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Solve(args) => solve::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Oracle { which } => oracle::run(which),
+        Command::Generate { which } => generate::run(which),
         Command::Bench { which } => bench::run(which),
     }
 }
