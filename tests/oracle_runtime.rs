@@ -148,7 +148,7 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
     let h = hierarchy::build(&scene, &BuildConfig::default());
     let caster = RayCaster::new(&scene);
     let radiosity = vec![[1.0; 3]; h.len()];
-    let services = Services { hierarchy: &h, caster: Some(&caster), visibility: VisibilityConfig::default(), radiosity: &radiosity, b_ref: 1.0 };
+    let services = Services { hierarchy: &h, caster: Some(&caster), visibility: VisibilityConfig::default(), radiosity: &radiosity, b_ref: 1.0, shafts: None };
     let bf = DagOracle::new(parse_graph(BF_TOML, Path::new("bf.toml")).expect("valid"), &[]).expect("valid");
     let vis = GraphBuilder::new("vis")
         .start("v")

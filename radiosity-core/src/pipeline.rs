@@ -7,6 +7,7 @@ use crate::refine::{self, Link, Oracle, RefineStats};
 use crate::scene::Scene;
 use crate::solve::{self, Solution, SolveConfig};
 use crate::visibility::{RayCaster, VisibilityConfig};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Settings of a full solve.
@@ -22,6 +23,8 @@ pub struct Config {
     pub max_passes: usize,
     /// Cast rays for visibility (false: every link is taken as fully visible).
     pub use_visibility: bool,
+    /// How link visibility is computed.
+    pub visibility_method: VisibilityMethod,
     /// Analyse the scene first and leave out what it does not need (visibility in a convex
     /// enclosure); see [`crate::analysis`].
     pub analyse: bool,
@@ -42,10 +45,23 @@ impl Default for Config {
             max_passes: 3,
             use_visibility: true,
             analyse: true,
+            visibility_method: VisibilityMethod::Rays,
             final_gather: true,
             leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
         }
     }
+}
+
+/// How link visibility is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VisibilityMethod {
+    /// Rays against a BVH of every input triangle.
+    Rays,
+    /// Shaft culling with the given bounding volumes: a link whose shaft one occluder blocks is
+    /// invisible and one whose shaft nothing enters is visible, both without a ray; other links cast
+    /// rays against the shaft's candidate occluders only. (Each link's candidates are searched
+    /// from the whole scene; inheriting the parent link's list is not wired into the driver yet.)
+    Shafts(crate::visibility::shaft::BoundingVolume),
 }
 
 /// Seconds spent per phase.
@@ -105,6 +121,8 @@ pub struct Solved {
     pub passes: usize,
     /// Coefficients of the leaf-resolution operator (0 when it was not used).
     pub leaf_entries: usize,
+    /// Links that shaft culling classified [invisible, visible] without casting a ray.
+    pub shaft_classified: [u64; 2],
     /// What the scene needs, when analysed.
     pub traits: Option<SceneTraits>,
     /// Machinery left out for this scene, in words.
@@ -126,6 +144,14 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let use_visibility = config.use_visibility && traits.as_ref().is_none_or(|t| t.needs_visibility);
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
+    let shaft_objects = match config.visibility_method {
+        VisibilityMethod::Shafts(volume) if use_visibility => {
+            Some(crate::visibility::shaft::ShaftObjects::new(scene, &crate::visibility::shaft::ObjectConfig { volume, ..Default::default() }))
+        }
+        _ => None,
+    };
+    let (shaft_rays, shaft_invisible, shaft_visible) = (AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0));
+    let shafts = shaft_objects.as_ref().map(|objects| refine::ShaftServices { objects, rays: &shaft_rays, invisible: &shaft_invisible, visible: &shaft_visible });
     let mut timings = Timings { build: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
     let mut radiosity = initial_radiosity(&h);
@@ -148,6 +174,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             links,
             &mut radiosity,
             b_ref,
+            shafts,
             &|l, p| progress(Progress::Refine { pass, links: l, pending: p }),
         );
         links = new_links;
@@ -189,8 +216,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         timings.solve += t.elapsed().as_secs_f64();
     }
     let error_estimate = Some(solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
-    let rays = caster.rays_cast();
-    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, traits, left_out, error_estimate, iterations, timings }
+    let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
+    let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
+    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, shaft_classified, traits, left_out, error_estimate, iterations, timings }
 }
 
 /// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene

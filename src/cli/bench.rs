@@ -14,9 +14,25 @@ pub enum BenchCommand {
     /// The three BF releases (hand-written, DAG runtime, `oracle!`) side by side: refinement time
     /// and ratio to hand-written, and whether links and radiosity are identical.
     Oracle(OracleBenchArgs),
+    /// Visibility by plain rays vs AABB and OBB shafts: links, elements, rays, time, peak RSS and the
+    /// largest difference to the rays solution, per scene.
+    Shafts(ShaftBenchArgs),
     /// What leaving out unneeded machinery saves: each scene solved with and without the scene
     /// analysis.
     LeaveOut(LeaveOutArgs),
+}
+
+/// Arguments of `bench shafts`.
+#[derive(clap::Args, Debug)]
+pub struct ShaftBenchArgs {
+    /// Scenes (files or generated names); default: cornell and the generated duplex, sj-geometry,
+    /// sj-shadow and stairs scenes.
+    pub scenes: Vec<String>,
+    #[command(flatten)]
+    pub options: SolveOptions,
+    /// Print one JSON document instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `bench oracle`.
@@ -62,6 +78,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Solve(args) => bench_solve(&args),
         BenchCommand::LeaveOut(args) => bench_leave_out(&args),
         BenchCommand::Oracle(args) => bench_oracle(&args),
+        BenchCommand::Shafts(args) => bench_shafts(&args),
     }
 }
 
@@ -180,11 +197,11 @@ fn print_row(scene: &str, s: &serde_json::Value) {
     println!(
         "{:<16} {:>8} {:>9} {:>10} {:>11} {:>6} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.1} {:>22}",
         name,
-        s["polygons"],
-        s["elements"],
-        s["links"],
-        s["rays"],
-        s["iterations"],
+        s["polygons"].as_u64().unwrap_or(0),
+        s["elements"].as_u64().unwrap_or(0),
+        s["links"].as_u64().unwrap_or(0),
+        s["rays"].as_u64().unwrap_or(0),
+        s["iterations"].as_u64().unwrap_or(0),
         f(&t["build"]),
         f(&t["refine"]),
         f(&t["solve"]),
@@ -249,5 +266,95 @@ fn bench_oracle(args: &OracleBenchArgs) -> anyhow::Result<()> {
         print!("{}", bench::format_table(&rows));
     }
     anyhow::ensure!(rows.iter().all(|r| r.identical), "the three releases disagree on some scene");
+    Ok(())
+}
+
+/// Solves `scene` in a child process into `out` and returns its `stats.json`.
+fn child_solve(exe: &std::path::Path, scene: &str, o: &SolveOptions, visibility: &str, out: &std::path::Path) -> anyhow::Result<serde_json::Value> {
+    let mut cmd = Command::new(exe);
+    cmd.arg("solve").arg("--quiet").arg("--no-image").arg("--out").arg(out);
+    if !super::GENERATED_SCENES.contains(&scene) {
+        let p = PathBuf::from(scene);
+        anyhow::ensure!(p.exists(), "{scene}: no such file");
+    }
+    cmd.arg(scene);
+    cmd.args(["--eps", &o.eps.to_string(), "--rays", &o.common.rays.to_string(), "--seed", &o.common.seed.to_string(), "--min-area", &o.common.min_area.to_string()]);
+    cmd.args(["--visibility", visibility]);
+    if o.common.allow_dark {
+        cmd.arg("--allow-dark");
+    }
+    if o.common.no_visibility {
+        cmd.arg("--no-visibility");
+    }
+    let status = cmd.status().with_context(|| format!("running {}", exe.display()))?;
+    anyhow::ensure!(status.success(), "{scene}: solve failed ({status})");
+    let path = out.join("stats.json");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{}: invalid JSON", path.display()))
+}
+
+/// `b_r,b_g,b_b` per polygon of a `patches.csv` written by this program.
+fn read_b(path: &std::path::Path) -> anyhow::Result<Vec<[f64; 3]>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    text.lines()
+        .skip(1)
+        .enumerate()
+        .map(|(i, l)| {
+            let f: Vec<&str> = l.split(',').collect();
+            let n = |k: usize| f.get(k).and_then(|v| v.parse::<f64>().ok()).with_context(|| format!("{}:{}: bad number", path.display(), i + 2));
+            Ok([n(4)?, n(5)?, n(6)?])
+        })
+        .collect()
+}
+
+fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
+    args.options.validate()?;
+    let scenes: Vec<String> = if args.scenes.is_empty() { super::GENERATED_SCENES.iter().map(|s| s.to_string()).collect() } else { args.scenes.clone() };
+    let exe = std::env::current_exe().context("locating this executable")?;
+    let tmp = std::env::temp_dir().join(format!("radiosity-bench-shafts-{}", std::process::id()));
+    let mut rows = Vec::new();
+    if !args.json {
+        println!("{:<18} {:<5} {:>9} {:>9} {:>11} {:>9} {:>9} {:>10} {:>8}", "scene", "method", "links", "elements", "rays", "time_s", "peak_MB", "max_diff", "speedup");
+    }
+    for (i, scene) in scenes.iter().enumerate() {
+        let mut reference: Option<(Vec<[f64; 3]>, f64)> = None;
+        for method in ["rays", "aabb", "obb"] {
+            let out = tmp.join(format!("{i}-{method}"));
+            let s = child_solve(&exe, scene, &args.options, method, &out)?;
+            let b = read_b(&out.join("patches.csv"))?;
+            let time = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN) + s["time_s"]["build"].as_f64().unwrap_or(0.0) + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
+            let (diff, speedup) = match &reference {
+                None => {
+                    reference = Some((b, time));
+                    (0.0, 1.0)
+                }
+                Some((rb, rt)) => {
+                    let max = rb.iter().flatten().fold(0.0f64, |m, v| m.max(*v)).max(f64::MIN_POSITIVE);
+                    let d = rb.iter().zip(&b).flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs())).fold(0.0f64, f64::max);
+                    (d / max, rt / time)
+                }
+            };
+            let row = serde_json::json!({
+                "scene": scene, "method": method, "links": s["links"], "elements": s["elements"], "rays": s["rays"],
+                "time_s": time, "peak_rss_bytes": s["peak_rss_bytes"], "max_rel_diff_to_rays": diff,
+            });
+            if !args.json {
+                println!(
+                    "{:<18} {:<5} {:>9} {:>9} {:>11} {:>9.3} {:>9.1} {:>10.2e} {:>8.2}",
+                    scene,
+                    method,
+                    s["links"].as_u64().unwrap_or(0),
+                    s["elements"].as_u64().unwrap_or(0),
+                    s["rays"].as_u64().unwrap_or(0),
+                    time, s["peak_rss_bytes"].as_f64().unwrap_or(f64::NAN) / 1e6, diff, speedup
+                );
+            }
+            rows.push(row);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    }
     Ok(())
 }

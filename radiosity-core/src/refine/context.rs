@@ -16,6 +16,22 @@ pub struct Services<'a> {
     pub radiosity: &'a [[f64; 3]],
     /// Reference radiosity that relative thresholds are measured against (the largest emission).
     pub b_ref: f64,
+    /// Shaft culling for visibility, when enabled: links are classified by their shafts first and
+    /// rays are cast against the shaft's candidate occluders only.
+    pub shafts: Option<ShaftServices<'a>>,
+}
+
+/// Shaft culling shared by a refinement pass.
+#[derive(Clone, Copy)]
+pub struct ShaftServices<'a> {
+    /// The scene's objects and their bounding volumes.
+    pub objects: &'a crate::visibility::shaft::ShaftObjects,
+    /// Segments cast against candidate lists.
+    pub rays: &'a std::sync::atomic::AtomicU64,
+    /// Links classified invisible by a single occluder (no ray cast).
+    pub invisible: &'a std::sync::atomic::AtomicU64,
+    /// Links classified fully visible (no candidate, no ray cast).
+    pub visible: &'a std::sync::atomic::AtomicU64,
 }
 
 /// Terms computed for one link and shared by the tools that read them.
@@ -126,9 +142,30 @@ impl<'a> LinkCtx<'a> {
                 return v;
             }
         }
-        let v = match self.services.caster {
-            None => 1.0,
-            Some(caster) => {
+        let v = match (self.services.caster, self.services.shafts) {
+            (None, _) => 1.0,
+            (Some(_), Some(shafts)) => {
+                use crate::visibility::shaft::{self, ShaftClass};
+                use std::sync::atomic::Ordering;
+                let verdict = shaft::classify(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, None);
+                match verdict.class {
+                    ShaftClass::Invisible => {
+                        shafts.invisible.fetch_add(1, Ordering::Relaxed);
+                        0.0
+                    }
+                    ShaftClass::Visible => {
+                        shafts.visible.fetch_add(1, Ordering::Relaxed);
+                        1.0
+                    }
+                    ShaftClass::Partial { .. } => {
+                        let config = VisibilityConfig { rays, ..self.services.visibility };
+                        let (v, n) = shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &verdict.candidates, &config);
+                        shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
+                        v
+                    }
+                }
+            }
+            (Some(caster), None) => {
                 let config = VisibilityConfig { rays, ..self.services.visibility };
                 caster.visibility(self.services.hierarchy, self.emitter, self.receiver, &config)
             }

@@ -65,6 +65,7 @@ pub fn refine(
     links: Vec<Link>,
     radiosity: &mut Vec<[f64; 3]>,
     b_ref: f64,
+    shafts: Option<super::ShaftServices<'_>>,
     progress: &dyn Fn(u64, u64),
 ) -> (Vec<Link>, RefineStats) {
     let mut stats = RefineStats::default();
@@ -76,7 +77,7 @@ pub fn refine(
     let mut out = Vec::with_capacity(links.len().max(1024));
     while !pending.is_empty() {
         let outcomes: Vec<Outcome> = {
-            let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref };
+            let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref, shafts };
             pending.par_iter().map(|c| evaluate(&services, oracle, c)).collect()
         };
         let mut next = Vec::new();

@@ -7,7 +7,7 @@ mod context;
 mod driver;
 
 pub use bf_hand::{BfHand, BfParams};
-pub use context::{LinkCtx, LinkData, Services};
+pub use context::{LinkCtx, LinkData, Services, ShaftServices};
 pub use driver::{Link, RefineStats, refine};
 
 /// What an oracle decides for a link.
