@@ -159,6 +159,7 @@ fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
                 serde_json::json!({
                     "scene": scene, "polygons": s["polygons"], "elements": s["elements"], "links": s["links"],
                     "rays": s["rays"], "iterations": s["iterations"], "time_s": s["time_s"], "peak_rss_bytes": s["peak_rss_bytes"],
+                    "error_estimate": s["error_estimate"],
                 })
             })
             .collect();
@@ -195,7 +196,7 @@ fn print_row(scene: &str, s: &serde_json::Value) {
     let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
     let rp = renderpark_reference(name).map_or("-".to_string(), |(t, m)| format!("{t} / {m}"));
     println!(
-        "{:<16} {:>8} {:>9} {:>10} {:>11} {:>6} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.1} {:>22}",
+        "{:<16} {:>8} {:>9} {:>10} {:>11} {:>6} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.1} {:>8.3} {:>22}",
         name,
         s["polygons"].as_u64().unwrap_or(0),
         s["elements"].as_u64().unwrap_or(0),
@@ -207,6 +208,7 @@ fn print_row(scene: &str, s: &serde_json::Value) {
         f(&t["solve"]),
         f(&t["total"]),
         f(&s["peak_rss_bytes"]) / 1e6,
+        100.0 * f(&s["error_estimate"]),
         rp
     );
 }
