@@ -88,7 +88,7 @@ fn renderpark_reference(name: &str) -> Option<(&'static str, &'static str)> {
     match name {
         "cube.mgf" => Some(("0.31", "19")),
         "office2.mgf" => Some(("3.5", "46")),
-        "office3.mgf" => Some(("96", "193")),
+        "office3.mgf" | "office.mgf" => Some(("96", "193")),
         "soda.mgf" => Some((">233 (unfinished)", ">677")),
         _ => None,
     }

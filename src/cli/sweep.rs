@@ -25,8 +25,8 @@ const REFERENCE_RAYS: u32 = 64;
 pub struct SweepArgs {
     /// Scene file, `furnace` (a closed box with an analytic answer), or none for the Cornell box.
     pub scene: Option<String>,
-    /// Oracles to compare, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "bf-hand")]
+    /// Oracles to compare, comma-separated (names as in `radiosity oracle list`, or graph files).
+    #[arg(long, value_delimiter = ',', default_value = "bf,bf-dag")]
     pub oracle: Vec<String>,
     /// Thresholds, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "0.5,0.2,0.1,0.05,0.02")]
@@ -50,10 +50,7 @@ type PerPolygon = Vec<[f64; 3]>;
 
 /// Builds an oracle by name.
 pub fn oracle_by_name(name: &str, eps: f64) -> anyhow::Result<Box<dyn Oracle>> {
-    match name {
-        "bf-hand" => Ok(Box::new(radiosity::refine::BfHand { params: radiosity::refine::BfParams { eps } })),
-        other => anyhow::bail!("unknown oracle `{other}` (oracles: bf-hand)"),
-    }
+    Ok(radiosity::oracle::registry::oracle(name, &[("eps".to_string(), eps)])?)
 }
 
 /// Runs `radiosity sweep`.
