@@ -341,9 +341,10 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
                 "time_s": time, "peak_rss_bytes": s["peak_rss_bytes"], "max_rel_diff_to_rays": diff,
             });
             if !args.json {
+                let name = std::path::Path::new(scene).file_name().and_then(|n| n.to_str()).unwrap_or(scene);
                 println!(
                     "{:<18} {:<5} {:>9} {:>9} {:>11} {:>9.3} {:>9.1} {:>10.2e} {:>8.2}",
-                    scene,
+                    name,
                     method,
                     s["links"].as_u64().unwrap_or(0),
                     s["elements"].as_u64().unwrap_or(0),

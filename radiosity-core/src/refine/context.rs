@@ -82,13 +82,36 @@ pub struct LinkCtx<'a> {
     pub receiver: u32,
     /// Memoised terms.
     pub data: LinkData,
+    /// Candidate occluders of the link this one was subdivided from (shaft culling).
+    pub parent_candidates: Option<std::sync::Arc<[u32]>>,
+    /// Memoised shaft classification and candidate list.
+    pub shaft: Option<(crate::visibility::shaft::ShaftClass, std::sync::Arc<[u32]>)>,
 }
 
 impl<'a> LinkCtx<'a> {
     /// A fresh context.
     #[must_use]
     pub fn new(services: &'a Services<'a>, emitter: u32, receiver: u32) -> LinkCtx<'a> {
-        LinkCtx { services, emitter, receiver, data: LinkData::default() }
+        LinkCtx { services, emitter, receiver, data: LinkData::default(), parent_candidates: None, shaft: None }
+    }
+
+    /// The shaft classification of this link (memoised), when shaft culling is enabled: candidates
+    /// are searched among the parent link's list when there is one.
+    pub fn shaft_verdict(&mut self) -> Option<crate::visibility::shaft::ShaftClass> {
+        let shafts = self.services.shafts?;
+        self.services.caster?;
+        if let Some((class, _)) = &self.shaft {
+            return Some(*class);
+        }
+        let v = crate::visibility::shaft::classify(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, self.parent_candidates.as_deref());
+        self.shaft = Some((v.class, std::sync::Arc::from(v.candidates)));
+        Some(v.class)
+    }
+
+    /// The candidate occluders of this link's shaft, once [`LinkCtx::shaft_verdict`] ran.
+    #[must_use]
+    pub fn shaft_candidates(&self) -> Option<std::sync::Arc<[u32]>> {
+        self.shaft.as_ref().map(|(_, c)| c.clone())
     }
 
     /// The hierarchy.
@@ -147,8 +170,7 @@ impl<'a> LinkCtx<'a> {
             (Some(_), Some(shafts)) => {
                 use crate::visibility::shaft::{self, ShaftClass};
                 use std::sync::atomic::Ordering;
-                let verdict = shaft::classify(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, None);
-                match verdict.class {
+                match self.shaft_verdict().expect("shafts enabled") {
                     ShaftClass::Invisible => {
                         shafts.invisible.fetch_add(1, Ordering::Relaxed);
                         0.0
@@ -159,7 +181,8 @@ impl<'a> LinkCtx<'a> {
                     }
                     ShaftClass::Partial { .. } => {
                         let config = VisibilityConfig { rays, ..self.services.visibility };
-                        let (v, n) = shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &verdict.candidates, &config);
+                        let cands = self.shaft_candidates().expect("classified above");
+                        let (v, n) = shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &cands, &config);
                         shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
                         v
                     }

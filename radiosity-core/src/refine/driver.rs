@@ -6,6 +6,7 @@ use crate::formfactor::FormFactorQuality;
 use crate::hierarchy::{ElementId, Hierarchy};
 use crate::visibility::{RayCaster, VisibilityConfig};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Form factors at or below this are dropped rather than stored as links.
 pub const MIN_LINK_FORM_FACTOR: f64 = 0.0;
@@ -38,17 +39,19 @@ pub struct RefineStats {
     pub dropped: u64,
 }
 
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Candidate {
     source: ElementId,
     receiver: ElementId,
     /// Form factor and visibility of an existing link being re-examined.
     existing: Option<(f64, f64)>,
+    /// Candidate occluders inherited from the link this one was split from (shaft culling).
+    cands: Option<Arc<[u32]>>,
 }
 
 enum Outcome {
     Keep(Link, bool),
-    Split(Decision),
+    Split(Decision, Option<Arc<[u32]>>),
     Drop,
 }
 
@@ -70,9 +73,9 @@ pub fn refine(
 ) -> (Vec<Link>, RefineStats) {
     let mut stats = RefineStats::default();
     let mut pending: Vec<Candidate> = if links.is_empty() {
-        vec![Candidate { source: h.root, receiver: h.root, existing: None }]
+        vec![Candidate { source: h.root, receiver: h.root, existing: None, cands: None }]
     } else {
-        links.iter().map(|l| Candidate { source: l.source, receiver: l.receiver, existing: Some((l.ff, l.vis)) }).collect()
+        links.iter().map(|l| Candidate { source: l.source, receiver: l.receiver, existing: Some((l.ff, l.vis)), cands: None }).collect()
     };
     let mut out = Vec::with_capacity(links.len().max(1024));
     while !pending.is_empty() {
@@ -96,10 +99,10 @@ pub fn refine(
                     stats.oracle_calls += u64::from(c.source != c.receiver);
                     stats.dropped += 1;
                 }
-                Outcome::Split(d) => {
+                Outcome::Split(d, cands) => {
                     stats.oracle_calls += u64::from(c.source != c.receiver);
                     stats.subdivided += 1;
-                    split(h, radiosity, c, d, &mut next);
+                    split(h, radiosity, c, d, cands, &mut next);
                 }
             }
         }
@@ -114,9 +117,10 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
     let h = services.hierarchy;
     if c.source == c.receiver {
         // Self-links: a cluster interacts with itself through its children; a planar surface does not.
-        return if h.get(c.source).is_cluster() { Outcome::Split(Decision::SubdivideBoth) } else { Outcome::Drop };
+        return if h.get(c.source).is_cluster() { Outcome::Split(Decision::SubdivideBoth, None) } else { Outcome::Drop };
     }
     let mut ctx = LinkCtx::new(services, c.source, c.receiver);
+    ctx.parent_candidates.clone_from(&c.cands);
     match oracle.decide(&mut ctx) {
         Decision::Link => {
             if let Some((ff, vis)) = c.existing {
@@ -141,12 +145,19 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
                 (Decision::SubdivideReceiver, true, false) | (Decision::SubdivideBoth, true, false) => Decision::SubdivideEmitter,
                 (d, _, _) => d,
             };
-            Outcome::Split(d)
+            // Shaft culling: a link one occluder blocks whole is dropped instead of refined (all
+            // its children would be invisible too); children search only this link's candidates.
+            let cands = match ctx.shaft_verdict() {
+                Some(crate::visibility::shaft::ShaftClass::Invisible) => return Outcome::Drop,
+                Some(_) => ctx.shaft_candidates(),
+                None => None,
+            };
+            Outcome::Split(d, cands)
         }
     }
 }
 
-fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, c: &Candidate, d: Decision, next: &mut Vec<Candidate>) {
+fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, c: &Candidate, d: Decision, cands: Option<Arc<[u32]>>, next: &mut Vec<Candidate>) {
     let mut children_of = |h: &mut Hierarchy, id: ElementId| -> Vec<ElementId> {
         if h.get(id).n_children == 0 {
             h.subdivide(id);
@@ -161,12 +172,12 @@ fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, c: &Candidate, d: Dec
     match d {
         Decision::SubdivideEmitter => {
             for s in children_of(h, c.source) {
-                next.push(Candidate { source: s, receiver: c.receiver, existing: None });
+                next.push(Candidate { source: s, receiver: c.receiver, existing: None, cands: cands.clone() });
             }
         }
         Decision::SubdivideReceiver => {
             for r in children_of(h, c.receiver) {
-                next.push(Candidate { source: c.source, receiver: r, existing: None });
+                next.push(Candidate { source: c.source, receiver: r, existing: None, cands: cands.clone() });
             }
         }
         Decision::SubdivideBoth => {
@@ -174,7 +185,7 @@ fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, c: &Candidate, d: Dec
             let rs = if c.receiver == c.source { ss.clone() } else { children_of(h, c.receiver) };
             for &r in &rs {
                 for &s in &ss {
-                    next.push(Candidate { source: s, receiver: r, existing: None });
+                    next.push(Candidate { source: s, receiver: r, existing: None, cands: cands.clone() });
                 }
             }
         }
