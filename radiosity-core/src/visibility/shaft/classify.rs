@@ -17,6 +17,9 @@ use crate::hierarchy::{ElementId, Hierarchy};
 /// leaves out as well (its end fractions).
 pub const GRAZE_REL_TOL: f64 = 1e-6;
 
+/// Most candidates tried as single occluders per link (the largest by bounding-box diagonal).
+pub const MAX_OCCLUDER_TESTS: usize = 8;
+
 /// What a shaft says about a link's visibility.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShaftClass {
@@ -97,12 +100,20 @@ pub fn classify(objects: &ShaftObjects, h: &Hierarchy, emitter: ElementId, recei
         return ShaftVerdict { class: ShaftClass::Visible, candidates, occluder: None };
     }
     let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
+    // Try the largest candidates only: an occluder that blocks a whole shaft is big compared with
+    // the others, and testing fewer never makes the answer less conservative.
+    let n_blocking = blocking.len() as u32;
+    if blocking.len() > MAX_OCCLUDER_TESTS {
+        let size = |id: &u32| objects.objects[*id as usize].aabb.diagonal();
+        blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)));
+        blocking.truncate(MAX_OCCLUDER_TESTS);
+    }
     for &id in &blocking {
         if occludes(objects, id, &pv, &qv, &own) {
             return ShaftVerdict { class: ShaftClass::Invisible, candidates, occluder: Some(id) };
         }
     }
-    ShaftVerdict { class: ShaftClass::Partial { candidates: blocking.len() as u32 }, candidates, occluder: None }
+    ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None }
 }
 
 /// Whether object `id` blocks every segment between the hulls of `p` and `q` on its own, as a closed
