@@ -90,6 +90,10 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         for &eps in &args.eps {
             let oracle = oracle_by_name(name, eps)?;
             let t = Instant::now();
+            let mut config = config;
+            if name == "shaft" && config.visibility_method == pipeline::VisibilityMethod::Rays {
+                config.visibility_method = pipeline::VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Obb);
+            }
             let solved = pipeline::run(&scene, oracle.as_ref(), &config, &|_| {});
             let time = t.elapsed().as_secs_f64();
             let b = per_polygon(&solved);

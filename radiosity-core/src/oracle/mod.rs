@@ -13,6 +13,7 @@ mod probe;
 pub mod registry;
 pub mod runtime;
 pub mod scenes;
+pub mod shaft;
 pub mod study;
 pub mod tools;
 

@@ -26,13 +26,14 @@ pub const ORACLES: &[OracleInfo] = &[
     OracleInfo { name: "bf", release: "flat", doc: "classic BF refiner compiled by `oracle!`" },
     OracleInfo { name: "bf-dag", release: "dag", doc: "classic BF refiner interpreted by the DAG runtime" },
     OracleInfo { name: "bf-hand", release: "hand", doc: "classic BF refiner written by hand (the baseline)" },
+    OracleInfo { name: "shaft", release: "flat", doc: "shaft oracle compiled by `oracle!` (solve turns on OBB shaft culling)" },
 ];
 
 /// Why a name did not give an oracle.
 #[derive(Debug, thiserror::Error)]
 pub enum RegistryError {
     /// Neither a built-in name nor a graph file.
-    #[error("unknown oracle `{0}` (oracles: bf, bf-dag, bf-hand, or a graph file `*.toml`)")]
+    #[error("unknown oracle `{0}` (oracles: bf, bf-dag, bf-hand, shaft, or a graph file `*.toml`)")]
     Unknown(String),
     /// A parameter was rejected.
     #[error(transparent)]
@@ -50,6 +51,7 @@ pub fn graph(name: &str) -> Result<Graph, RegistryError> {
     match name {
         "bf" | "bf-hand" => Ok(BfFlat::<NoProbe>::GRAPH),
         "bf-dag" => Ok(parse_graph(BF_TOML, Path::new("<bf>"))?),
+        "shaft" => Ok(super::shaft::ShaftOracle::<NoProbe>::GRAPH),
         path if path.ends_with(".toml") => Ok(load_graph(Path::new(path))?),
         other => Err(RegistryError::Unknown(other.to_owned())),
     }
@@ -85,6 +87,13 @@ pub fn oracle(name: &str, params: &[(String, f64)]) -> Result<Box<dyn Oracle>, R
                 }
             }
             Ok(Box::new(BfHand { params: p }))
+        }
+        "shaft" => {
+            let mut p = super::shaft::ShaftOracleParams::default();
+            for (n, v) in params {
+                p.set(n, *v)?;
+            }
+            Ok(Box::new(super::shaft::ShaftOracle::new(p)))
         }
         _ => Ok(Box::new(DagOracle::new(g, params)?)),
     }
