@@ -17,6 +17,10 @@ pub enum BenchCommand {
     /// Visibility by plain rays vs AABB and OBB shafts: links, elements, rays, time, peak RSS and the
     /// largest difference to the rays solution, per scene.
     Shafts(ShaftBenchArgs),
+    /// A generated tree solved fully (flattened, with clustering) and by hierarchical
+    /// instantiation, each in its own process: time, peak RSS, links, and the instanced solution's
+    /// error as a percentage of the full solution's largest radiosity.
+    Instancing(InstancingBenchArgs),
     /// What leaving out unneeded machinery saves: each scene solved with and without the scene
     /// analysis.
     LeaveOut(LeaveOutArgs),
@@ -33,6 +37,26 @@ pub struct ShaftBenchArgs {
     /// Print one JSON document instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Arguments of `bench instancing`.
+#[derive(clap::Args, Debug)]
+pub struct InstancingBenchArgs {
+    /// Tree age in years.
+    #[arg(long, default_value_t = 10)]
+    pub age: u32,
+    /// Tree seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Refinement threshold of both methods.
+    #[arg(long, default_value_t = 0.05)]
+    pub eps: f64,
+    /// Print one JSON document instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Internal: run one method (`full` or `instanced`) and write its per-polygon means here.
+    #[arg(long, hide = true, num_args = 2, value_names = ["METHOD", "FILE"])]
+    pub child: Vec<String>,
 }
 
 /// Arguments of `bench oracle`.
@@ -78,6 +102,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Solve(args) => bench_solve(&args),
         BenchCommand::LeaveOut(args) => bench_leave_out(&args),
         BenchCommand::Oracle(args) => bench_oracle(&args),
+        BenchCommand::Instancing(args) => bench_instancing(&args),
         BenchCommand::Shafts(args) => bench_shafts(&args),
     }
 }
@@ -359,5 +384,81 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);
     }
+    Ok(())
+}
+
+fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
+    use radiosity::instancing::bench::{BenchRow, bench_full, bench_instanced, load_means, save_means};
+    use radiosity::instancing::solver::relative_error;
+    use radiosity::instancing::{InstancedConfig, generate_tree};
+    anyhow::ensure!((1..=200).contains(&args.age), "--age must be between 1 and 200");
+    anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
+    if let [method, file] = args.child.as_slice() {
+        let scene = generate_tree(args.age, args.seed);
+        let mut config = InstancedConfig::default();
+        config.bf.eps = args.eps;
+        config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
+        let (row, means) = match method.as_str() {
+            "full" => {
+                let (row, means) = bench_full(&scene, &config)?;
+                (row, Some(means))
+            }
+            "instanced" => bench_instanced(&scene, &config, true)?,
+            other => anyhow::bail!("unknown method `{other}`"),
+        };
+        if let Some(m) = means {
+            save_means(std::path::Path::new(file), &m)?;
+        }
+        println!("{}", serde_json::to_string(&row)?);
+        return Ok(());
+    }
+    let exe = std::env::current_exe().context("locating this executable")?;
+    let dir = std::env::temp_dir();
+    let mut rows: Vec<BenchRow> = Vec::new();
+    let mut files = Vec::new();
+    for method in ["instanced", "full"] {
+        let file = dir.join(format!("radiosity-bench-instancing-{method}-{}.bin", std::process::id()));
+        let o = Command::new(&exe)
+            .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string(), "--eps", &args.eps.to_string(), "--child", method])
+            .arg(&file)
+            .output()
+            .with_context(|| format!("running {}", exe.display()))?;
+        anyhow::ensure!(o.status.success(), "{method} solve failed: {}", String::from_utf8_lossy(&o.stderr).trim());
+        let text = String::from_utf8_lossy(&o.stdout);
+        rows.push(serde_json::from_str(text.lines().last().unwrap_or("")).with_context(|| format!("{method}: unreadable result"))?);
+        files.push(file);
+    }
+    let (inst, full) = (load_means(&files[0])?, load_means(&files[1])?);
+    for f in &files {
+        let _ = std::fs::remove_file(f);
+    }
+    let (worst, mean) = relative_error(&full, &inst);
+    let (ri, rf) = (&rows[0], &rows[1]);
+    if args.json {
+        let doc = serde_json::json!({
+            "tree": {
+                "polygons": rf.polygons,
+                "full": {"time_s": rf.seconds, "peak_rss_bytes": rf.peak_rss_bytes, "links": rf.links},
+                "instanced": {"time_s": ri.seconds, "peak_rss_bytes": ri.peak_rss_bytes, "links": ri.links},
+                "error_pct_of_max": 100.0 * worst,
+                "error_mean_pct_of_max": 100.0 * mean,
+            },
+            "forests": [],
+        });
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(());
+    }
+    println!("tree age {} seed {}, {} polygons (two-sided leaves as pairs), eps {}", args.age, args.seed, rf.polygons, args.eps);
+    println!("{:<10} {:>10} {:>10} {:>10} {:>8}", "method", "time_s", "peak_MB", "links", "solves");
+    for r in &rows {
+        println!("{:<10} {:>10.3} {:>10.1} {:>10} {:>8}", r.method, r.seconds, r.peak_rss_bytes as f64 / 1e6, r.links, r.local_solves);
+    }
+    println!(
+        "instanced vs full: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity",
+        rf.seconds / ri.seconds.max(1e-9),
+        rf.peak_rss_bytes as f64 / ri.peak_rss_bytes.max(1) as f64,
+        100.0 * worst,
+        100.0 * mean
+    );
     Ok(())
 }
