@@ -320,20 +320,6 @@ fn child_solve(exe: &std::path::Path, scene: &str, o: &SolveOptions, visibility:
     serde_json::from_str(&text).with_context(|| format!("{}: invalid JSON", path.display()))
 }
 
-/// `b_r,b_g,b_b` per polygon of a `patches.csv` written by this program.
-fn read_b(path: &std::path::Path) -> anyhow::Result<Vec<[f64; 3]>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    text.lines()
-        .skip(1)
-        .enumerate()
-        .map(|(i, l)| {
-            let f: Vec<&str> = l.split(',').collect();
-            let n = |k: usize| f.get(k).and_then(|v| v.parse::<f64>().ok()).with_context(|| format!("{}:{}: bad number", path.display(), i + 2));
-            Ok([n(4)?, n(5)?, n(6)?])
-        })
-        .collect()
-}
-
 fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
     args.options.validate()?;
     let scenes: Vec<String> = if args.scenes.is_empty() { super::GENERATED_SCENES.iter().map(|s| s.to_string()).collect() } else { args.scenes.clone() };
@@ -348,7 +334,7 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         for method in ["rays", "aabb", "obb"] {
             let out = tmp.join(format!("{i}-{method}"));
             let s = child_solve(&exe, scene, &args.options, method, &out)?;
-            let b = read_b(&out.join("patches.csv"))?;
+            let b = super::read_patches(&out.join("patches.csv"))?;
             let time = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN) + s["time_s"]["build"].as_f64().unwrap_or(0.0) + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
             let (diff, speedup) = match &reference {
                 None => {

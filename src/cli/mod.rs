@@ -7,8 +7,9 @@ mod progress;
 mod solve;
 mod sweep;
 
+use anyhow::Context;
 use clap::{Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Hierarchical radiosity with refinement oracles as decision graphs.
 #[derive(Parser, Debug)]
@@ -148,4 +149,34 @@ pub fn load_scene(path: Option<&PathBuf>, allow_dark: bool) -> anyhow::Result<ra
         Some("gen:stairs") => Ok(generated::stairs_with_beam()),
         Some(_) => Ok(radiosity::scene::load(path.expect("matched Some"), &radiosity::scene::LoadOptions { allow_dark })?),
     }
+}
+
+/// Reads `b_r,b_g,b_b` of a `patches.csv`.
+pub fn read_patches(path: &Path) -> anyhow::Result<Vec<[f64; 3]>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).with_context(|| format!("{}: no column `{name}`", path.display()));
+    let (r, g, b) = (col("b_r")?, col("b_g")?, col("b_b")?);
+    lines
+        .enumerate()
+        .map(|(i, line)| {
+            // The group and material columns are plain names (no commas) in files we write.
+            let f: Vec<&str> = line.split(',').collect();
+            let num = |k: usize| -> anyhow::Result<f64> {
+                f.get(k).and_then(|s| s.parse().ok()).with_context(|| format!("{}:{}: bad number in column {k}", path.display(), i + 2))
+            };
+            Ok([num(r)?, num(g)?, num(b)?])
+        })
+        .collect()
+}
+
+/// `config` adjusted for oracle `name`: the shaft oracle reads shaft classifications, so it turns
+/// OBB shaft culling on unless the user chose a bounding volume.
+pub fn config_for_oracle(name: &str, mut config: radiosity::pipeline::Config) -> radiosity::pipeline::Config {
+    use radiosity::pipeline::VisibilityMethod;
+    if name == "shaft" && config.visibility_method == VisibilityMethod::Rays {
+        config.visibility_method = VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Obb);
+    }
+    config
 }

@@ -53,12 +53,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         params.push(("eps".to_string(), args.options.eps));
     }
     let oracle = radiosity::oracle::registry::oracle(&args.oracle, &params)?;
-    let mut config = args.options.config();
-    if args.oracle == "shaft" && config.visibility_method == radiosity::pipeline::VisibilityMethod::Rays && config.use_visibility {
-        // The shaft oracle reads shaft classifications: turn shaft culling on (OBB) unless the
-        // user chose the volume.
-        config.visibility_method = radiosity::pipeline::VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Obb);
-    }
+    let config = super::config_for_oracle(&args.oracle, args.options.config());
     let solved = pipeline::run(&scene, oracle.as_ref(), &config, &|p| reporter.event(p));
     reporter.phase("writing outputs");
     let t_out = Instant::now();

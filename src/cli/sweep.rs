@@ -77,7 +77,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             let finest = args.eps.iter().copied().fold(f64::INFINITY, f64::min);
             cached_reference(&scene, &args.out, finest * REFERENCE_EPS_FACTOR, &config, args.quiet)?
         }
-        (path, _) => read_patches(Path::new(path))?,
+        (path, _) => super::read_patches(Path::new(path))?,
     };
     anyhow::ensure!(reference.len() == scene.polygons.len(), "reference has {} polygons, the scene {}", reference.len(), scene.polygons.len());
     let max_ref = reference.iter().flatten().fold(0.0f64, |m, v| m.max(*v)).max(f64::MIN_POSITIVE);
@@ -90,10 +90,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         for &eps in &args.eps {
             let oracle = oracle_by_name(name, eps)?;
             let t = Instant::now();
-            let mut config = config;
-            if name == "shaft" && config.visibility_method == pipeline::VisibilityMethod::Rays {
-                config.visibility_method = pipeline::VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Obb);
-            }
+            let config = super::config_for_oracle(name, config);
             let solved = pipeline::run(&scene, oracle.as_ref(), &config, &|_| {});
             let time = t.elapsed().as_secs_f64();
             let b = per_polygon(&solved);
@@ -160,7 +157,7 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
         if !quiet {
             println!("reference: cached {}", path.display());
         }
-        return read_patches(&path);
+        return super::read_patches(&path);
     }
     if !quiet {
         println!("reference: solving at eps {eps} with {} rays (cached in {})", config.visibility.rays, path.display());
@@ -172,26 +169,6 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
     radiosity::output::write_patches_csv(&mut w, scene, &results).with_context(|| format!("{}: cannot write", path.display()))?;
     drop(w);
     Ok(results.iter().map(|r| r.b).collect())
-}
-
-/// Reads `b_r,b_g,b_b` of a `patches.csv`.
-fn read_patches(path: &Path) -> anyhow::Result<PerPolygon> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).with_context(|| format!("{}: no column `{name}`", path.display()));
-    let (r, g, b) = (col("b_r")?, col("b_g")?, col("b_b")?);
-    lines
-        .enumerate()
-        .map(|(i, line)| {
-            // The group and material columns are plain names (no commas) in files we write.
-            let f: Vec<&str> = line.split(',').collect();
-            let num = |k: usize| -> anyhow::Result<f64> {
-                f.get(k).and_then(|s| s.parse().ok()).with_context(|| format!("{}:{}: bad number in column {k}", path.display(), i + 2))
-            };
-            Ok([num(r)?, num(g)?, num(b)?])
-        })
-        .collect()
 }
 
 /// A log–log plot of error (% of max) against run time, one series per oracle, with the estimates

@@ -29,10 +29,7 @@ pub fn error_estimate(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], irr
     }
     let samples = (ESTIMATE_BUDGET / leaves.len()).clamp(1, ESTIMATE_MAX_SAMPLES).min(leaves.len());
     let step = leaves.len() / samples;
-    let mut by_receiver: Vec<Vec<&Link>> = vec![Vec::new(); h.len()];
-    for l in links {
-        by_receiver[l.receiver as usize].push(l);
-    }
+    let by_receiver = super::leaf::LinksByReceiver::new(h, links);
     let picked: Vec<ElementId> = (0..samples).map(|k| leaves[k * step]).collect();
     picked
         .par_iter()
@@ -40,7 +37,7 @@ pub fn error_estimate(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], irr
             let mut fine = [0.0; 3];
             let mut a = leaf;
             while a != NONE {
-                for l in &by_receiver[a as usize] {
+                for l in by_receiver.at(a) {
                     let mut stack = vec![l.source];
                     while let Some(e) = stack.pop() {
                         let kids = h.children_of(e);

@@ -4,8 +4,7 @@
 //! in the hierarchy (largest at edges and corners, where the receiver touches its sources) at the cost
 //! of one pass over each leaf's chain of links.
 
-use crate::formfactor::{self, FormFactorQuality};
-use crate::hierarchy::{ElementId, Hierarchy, NONE};
+use crate::hierarchy::{ElementId, Hierarchy};
 use crate::refine::Link;
 use rayon::prelude::*;
 
@@ -14,34 +13,18 @@ use rayon::prelude::*;
 #[must_use]
 pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let n = h.len();
-    let mut sorted: Vec<&Link> = links.iter().collect();
-    sorted.sort_by_key(|l| (l.receiver, l.source));
-    let mut range = vec![(0u32, 0u32); n];
-    for (k, l) in sorted.iter().enumerate() {
-        let r = &mut range[l.receiver as usize];
-        if r.1 == 0 {
-            r.0 = k as u32;
-        }
-        r.1 = k as u32 + 1;
-    }
+    let index = super::leaf::LinksByReceiver::new(h, links);
     let leaves: Vec<ElementId> = h.leaves().collect();
     let gathered: Vec<[f64; 3]> = leaves
         .par_iter()
         .map(|&leaf| {
             let mut acc = [0.0; 3];
-            let mut a = leaf;
-            while a != NONE {
-                let (lo, hi) = range[a as usize];
-                for l in &sorted[lo as usize..hi as usize] {
-                    let ff = if a == leaf { l.ff } else { formfactor::link_form_factor(h, l.source, leaf, FormFactorQuality::Precise) };
-                    let f = ff * l.vis;
-                    let b = radiosity[l.source as usize];
-                    for c in 0..3 {
-                        acc[c] += f * b[c];
-                    }
+            index.leaf_chain(h, leaf, |source, f| {
+                let b = radiosity[source as usize];
+                for c in 0..3 {
+                    acc[c] += f * b[c];
                 }
-                a = h.get(a).parent;
-            }
+            });
             acc
         })
         .collect();

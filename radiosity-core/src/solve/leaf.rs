@@ -51,11 +51,14 @@ pub fn leaf_operator_entries(h: &Hierarchy, links: &[Link]) -> usize {
         .sum()
 }
 
-impl<'a> LeafOperator<'a> {
-    /// Builds the per-leaf lists, evaluating `link_form_factor(source, leaf)` for ancestor links.
-    #[must_use]
-    pub fn new(h: &'a Hierarchy, links: &[Link]) -> LeafOperator<'a> {
-        let op = Operator::new(h, links);
+/// Links grouped by receiver (sorted by receiver, then source).
+pub(super) struct LinksByReceiver<'l> {
+    sorted: Vec<&'l Link>,
+    range: Vec<(u32, u32)>,
+}
+
+impl<'l> LinksByReceiver<'l> {
+    pub(super) fn new(h: &Hierarchy, links: &'l [Link]) -> LinksByReceiver<'l> {
         let mut sorted: Vec<&Link> = links.iter().collect();
         sorted.sort_by_key(|l| (l.receiver, l.source));
         let mut range = vec![(0u32, 0u32); h.len()];
@@ -66,23 +69,45 @@ impl<'a> LeafOperator<'a> {
             }
             r.1 = k as u32 + 1;
         }
+        LinksByReceiver { sorted, range }
+    }
+
+    /// The links received by element `e`.
+    pub(super) fn at(&self, e: ElementId) -> &[&'l Link] {
+        let (lo, hi) = self.range[e as usize];
+        &self.sorted[lo as usize..hi as usize]
+    }
+
+    /// Calls `f(source, F·V)` for every link on the chain from `leaf` to the root, with the form
+    /// factor evaluated for `leaf` itself (a link at the leaf keeps its stored one).
+    pub(super) fn leaf_chain(&self, h: &Hierarchy, leaf: ElementId, mut f: impl FnMut(ElementId, f64)) {
+        let mut a = leaf;
+        while a != NONE {
+            for l in self.at(a) {
+                let ff = if a == leaf { l.ff } else { formfactor::link_form_factor(h, l.source, leaf, FormFactorQuality::Precise) };
+                f(l.source, ff * l.vis);
+            }
+            a = h.get(a).parent;
+        }
+    }
+}
+
+impl<'a> LeafOperator<'a> {
+    /// Builds the per-leaf lists, evaluating `link_form_factor(source, leaf)` for ancestor links.
+    #[must_use]
+    pub fn new(h: &'a Hierarchy, links: &[Link]) -> LeafOperator<'a> {
+        let op = Operator::new(h, links);
+        let index = LinksByReceiver::new(h, links);
         let lists: Vec<Vec<(ElementId, f64)>> = op
             .leaves()
             .par_iter()
             .map(|&leaf| {
                 let mut list = Vec::new();
-                let mut a = leaf;
-                while a != NONE {
-                    let (lo, hi) = range[a as usize];
-                    for l in &sorted[lo as usize..hi as usize] {
-                        let ff = if a == leaf { l.ff } else { formfactor::link_form_factor(h, l.source, leaf, FormFactorQuality::Precise) };
-                        let c = ff * l.vis;
-                        if c > 0.0 {
-                            list.push((l.source, c));
-                        }
+                index.leaf_chain(h, leaf, |source, c| {
+                    if c > 0.0 {
+                        list.push((source, c));
                     }
-                    a = h.get(a).parent;
-                }
+                });
                 list
             })
             .collect();

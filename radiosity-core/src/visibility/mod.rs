@@ -8,4 +8,4 @@
 mod rays;
 pub mod shaft;
 
-pub use rays::{Rng, RayCaster, VisibilityConfig};
+pub use rays::{KERNEL_REGULARISATION, Rng, RayCaster, SEGMENT_END_EPS, VisibilityConfig, sampled_visibility};

@@ -155,46 +155,52 @@ impl RayCaster {
         }
     }
 
-    /// Fraction of `n` stratified segments between the surfaces of `source` and `receiver` that are
-    /// unoccluded. Deterministic for a given seed, independent of thread scheduling.
+    /// Kernel-weighted visibility between `source` and `receiver` against every triangle of the
+    /// scene (see [`sampled_visibility`]).
     #[must_use]
     pub fn visibility(&self, h: &Hierarchy, source: u32, receiver: u32, config: &VisibilityConfig) -> f64 {
-        let n = config.rays.max(1) as usize;
-        let mut rng = Rng::for_link(config.seed, source, receiver);
-        let k = (n as f64).sqrt().ceil() as usize;
-        // Jittered strata on both ends, the receiver's strata in a shuffled order (Fisher–Yates).
-        let mut order: Vec<u32> = (0..(k * k) as u32).collect();
-        for i in (1..order.len()).rev() {
-            let j = (rng.next_u64() % (i as u64 + 1)) as usize;
-            order.swap(i, j);
-        }
-        // Each segment is weighted by the transfer kernel cosθ_s·cosθ_r / r² between its endpoints,
-        // so the result estimates ∫∫K·V / ∫∫K (what multiplies the unoccluded form factor) rather
-        // than the plain fraction of clear segments, which is biased where the kernel and the
-        // occlusion vary together (contact shadows).
-        let (el_s, el_r) = (h.get(source), h.get(receiver));
-        let reg = KERNEL_REGULARISATION * (el_s.radius + el_r.radius).powi(2);
-        let (mut clear, mut w_clear, mut w_all) = (0usize, 0.0f64, 0.0f64);
-        for i in 0..n {
-            let cell_s = i % (k * k);
-            let cell_r = order[i % (k * k)] as usize;
-            let su = ((cell_s % k) as f64 + rng.next_f64()) / k as f64;
-            let sv = ((cell_s / k) as f64 + rng.next_f64()) / k as f64;
-            let ru = ((cell_r % k) as f64 + rng.next_f64()) / k as f64;
-            let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
-            let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
-            let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
-            let d = pb - pa;
-            let r2 = d.length_squared();
-            let (na, nb) = (h.get(poly_a).normal, h.get(poly_b).normal);
-            let w = (na.dot(d).max(0.0) * (-nb.dot(d)).max(0.0)) / (r2 * (r2 + reg));
-            let visible = self.segment_clear(pa, pb, poly_a, poly_b);
-            if visible {
-                clear += 1;
-                w_clear += w;
-            }
-            w_all += w;
-        }
-        if w_all > 0.0 && w_all.is_finite() { w_clear / w_all } else { clear as f64 / n as f64 }
+        sampled_visibility(h, source, receiver, config, |pa, pb, poly_a, poly_b| self.segment_clear(pa, pb, poly_a, poly_b))
     }
+}
+
+/// Visibility between the surfaces of `source` and `receiver` from `config.rays` stratified
+/// segments, `clear(a, b, polygon_a, polygon_b)` deciding whether one is unoccluded. Jittered strata
+/// on both ends, the receiver's strata in a shuffled order (Fisher–Yates). Each segment is weighted
+/// by the transfer kernel cosθ_s·cosθ_r / r² between its endpoints (regularised by
+/// [`KERNEL_REGULARISATION`]), so the result estimates ∫∫K·V / ∫∫K (what multiplies the unoccluded
+/// form factor) rather than the plain fraction of clear segments, which is biased where the kernel
+/// and the occlusion vary together (contact shadows); the plain fraction is returned when no segment
+/// carries weight. Deterministic for a given seed, independent of thread scheduling; every caster
+/// (the global BVH, shaft candidate lists) samples the same segments through this function.
+pub fn sampled_visibility(h: &Hierarchy, source: u32, receiver: u32, config: &VisibilityConfig, mut clear: impl FnMut(DVec3, DVec3, u32, u32) -> bool) -> f64 {
+    let n = config.rays.max(1) as usize;
+    let mut rng = Rng::for_link(config.seed, source, receiver);
+    let k = (n as f64).sqrt().ceil() as usize;
+    let mut order: Vec<u32> = (0..(k * k) as u32).collect();
+    for i in (1..order.len()).rev() {
+        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    let reg = KERNEL_REGULARISATION * (h.get(source).radius + h.get(receiver).radius).powi(2);
+    let (mut n_clear, mut w_clear, mut w_all) = (0usize, 0.0f64, 0.0f64);
+    for i in 0..n {
+        let cell_s = i % (k * k);
+        let cell_r = order[i % (k * k)] as usize;
+        let su = ((cell_s % k) as f64 + rng.next_f64()) / k as f64;
+        let sv = ((cell_s / k) as f64 + rng.next_f64()) / k as f64;
+        let ru = ((cell_r % k) as f64 + rng.next_f64()) / k as f64;
+        let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
+        let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
+        let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
+        let d = pb - pa;
+        let r2 = d.length_squared();
+        let (na, nb) = (h.get(poly_a).normal, h.get(poly_b).normal);
+        let w = (na.dot(d).max(0.0) * (-nb.dot(d)).max(0.0)) / (r2 * (r2 + reg));
+        if clear(pa, pb, poly_a, poly_b) {
+            n_clear += 1;
+            w_clear += w;
+        }
+        w_all += w;
+    }
+    if w_all > 0.0 && w_all.is_finite() { w_clear / w_all } else { n_clear as f64 / n as f64 }
 }

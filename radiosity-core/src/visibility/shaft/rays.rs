@@ -9,15 +9,11 @@ use super::classify::shaft_of;
 use super::objects::ShaftObjects;
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
-use crate::visibility::{Rng, VisibilityConfig};
+use crate::visibility::VisibilityConfig;
 
 /// Fraction of the segment length left out at each end, as in the global ray caster, so that the
 /// endpoints' neighbours that touch them (a wall meeting the floor) do not occlude.
-pub const SEGMENT_END_EPS: f64 = 1e-5;
-
-/// Regularisation of the kernel weights of visibility samples, relative to the squared sum of the
-/// two elements' radii; the same value as the global caster's (its constant is private to it).
-pub const KERNEL_REGULARISATION: f64 = 1e-4;
+pub const SEGMENT_END_EPS: f64 = crate::visibility::SEGMENT_END_EPS as f64;
 
 /// Whether the segment `a`–`b` (without its end fractions [`SEGMENT_END_EPS`]) misses every
 /// polygon of the `candidates` objects other than `skip_a` and `skip_b`.
@@ -152,38 +148,10 @@ pub fn visibility_among(
         }
     }
     polys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.polygon.cmp(&b.1.polygon)));
-    let n = config.rays.max(1) as usize;
-    let mut rng = Rng::for_link(config.seed, source, receiver);
-    let k = (n as f64).sqrt().ceil() as usize;
-    let mut order: Vec<u32> = (0..(k * k) as u32).collect();
-    for i in (1..order.len()).rev() {
-        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
-        order.swap(i, j);
-    }
-    let reg = KERNEL_REGULARISATION * (h.get(source).radius + h.get(receiver).radius).powi(2);
-    let (mut clear, mut w_clear, mut w_all) = (0usize, 0.0f64, 0.0f64);
-    for i in 0..n {
-        let cell_s = i % (k * k);
-        let cell_r = order[i % (k * k)] as usize;
-        let su = ((cell_s % k) as f64 + rng.next_f64()) / k as f64;
-        let sv = ((cell_s / k) as f64 + rng.next_f64()) / k as f64;
-        let ru = ((cell_r % k) as f64 + rng.next_f64()) / k as f64;
-        let rv = ((cell_r / k) as f64 + rng.next_f64()) / k as f64;
-        let (pa, poly_a) = h.sample_point(source, su, sv, rng.next_f64());
-        let (pb, poly_b) = h.sample_point(receiver, ru, rv, rng.next_f64());
-        let d = pb - pa;
-        let r2 = d.length_squared();
-        let (na, nb) = (h.get(poly_a).normal, h.get(poly_b).normal);
-        let w = (na.dot(d).max(0.0) * (-nb.dot(d)).max(0.0)) / (r2 * (r2 + reg));
-        let blocked = polys.iter().any(|(_, p)| p.polygon != poly_a && p.polygon != poly_b && p.hit_by(pa, pb));
-        if !blocked {
-            clear += 1;
-            w_clear += w;
-        }
-        w_all += w;
-    }
-    let v = if w_all > 0.0 && w_all.is_finite() { w_clear / w_all } else { clear as f64 / n as f64 };
-    (v, n as u32)
+    let v = crate::visibility::sampled_visibility(h, source, receiver, config, |pa, pb, poly_a, poly_b| {
+        !polys.iter().any(|(_, p)| p.polygon != poly_a && p.polygon != poly_b && p.hit_by(pa, pb))
+    });
+    (v, config.rays.max(1))
 }
 
 #[cfg(test)]
