@@ -43,7 +43,11 @@ fn main() {
         for age in [5u32, 10, 15, 20, 25, 30, 35] {
             let t = generate_tree(age, args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1));
             let n = t.flattened_counts(false)[t.root as usize];
-            println!("age {age}: {} prototypes, {n} polygons flattened ({} with two-sided pairs)", t.prototypes.len(), t.flattened_counts(true)[t.root as usize]);
+            println!(
+                "age {age}: {} prototypes, {n} polygons flattened ({} with two-sided pairs)",
+                t.prototypes.len(),
+                t.flattened_counts(true)[t.root as usize]
+            );
         }
         return;
     }
@@ -94,7 +98,8 @@ fn main() {
         }
         let o = cmd.output().expect("child runs");
         let text = String::from_utf8_lossy(&o.stdout);
-        let row: BenchRow = serde_json::from_str(text.lines().last().unwrap_or("")).unwrap_or_else(|_| panic!("child failed: {}", String::from_utf8_lossy(&o.stderr)));
+        let row: BenchRow = serde_json::from_str(text.lines().last().unwrap_or(""))
+            .unwrap_or_else(|_| panic!("child failed: {}", String::from_utf8_lossy(&o.stderr)));
         eprintln!("{method}: {text}");
         rows.push(row);
     }
@@ -103,8 +108,21 @@ fn main() {
     let (worst, mean) = relative_error(&f, &a);
     println!("method,eps,polygons,seconds,peak_rss_mb,links,local_solves");
     for r in &rows {
-        println!("{},{},{},{:.3},{:.1},{},{}", r.method, r.eps, r.polygons, r.seconds, r.peak_rss_bytes as f64 / 1048576.0, r.links, r.local_solves);
+        println!(
+            "{},{},{},{:.3},{:.1},{},{}",
+            r.method,
+            r.eps,
+            r.polygons,
+            r.seconds,
+            r.peak_rss_bytes as f64 / 1048576.0,
+            r.links,
+            r.local_solves
+        );
     }
     println!("error of instanced vs full, % of max radiosity: max {:.3}, area-weighted mean {:.3}", 100.0 * worst, 100.0 * mean);
-    println!("speed-up {:.2}x, memory ratio {:.2}x", rows[1].seconds / rows[0].seconds.max(1e-9), rows[1].peak_rss_bytes as f64 / rows[0].peak_rss_bytes.max(1) as f64);
+    println!(
+        "speed-up {:.2}x, memory ratio {:.2}x",
+        rows[1].seconds / rows[0].seconds.max(1e-9),
+        rows[1].peak_rss_bytes as f64 / rows[0].peak_rss_bytes.max(1) as f64
+    );
 }

@@ -18,6 +18,15 @@ fn main() {
     let eps: f64 = std::env::args().nth(2).and_then(|e| e.parse().ok()).unwrap_or(0.01);
     let mut config = pipeline::Config::default();
     config.final_gather = std::env::args().nth(3).is_none();
-    let solved = pipeline::run(&flat, &BfHand { params: radiosity_core::refine::BfParams { eps } }, &config, &|p| eprintln!("{:.1}s {p:?}", t.elapsed().as_secs_f64()));
-    println!("{} polygons, {} elements, {} links, {:?} {:.2}s", flat.polygons.len(), solved.hierarchy.len(), solved.links.len(), solved.timings, t.elapsed().as_secs_f64());
+    let solved = pipeline::run(&flat, &BfHand { params: radiosity_core::refine::BfParams { eps } }, &config, &|p| {
+        eprintln!("{:.1}s {p:?}", t.elapsed().as_secs_f64())
+    });
+    println!(
+        "{} polygons, {} elements, {} links, {:?} {:.2}s",
+        flat.polygons.len(),
+        solved.hierarchy.len(),
+        solved.links.len(),
+        solved.timings,
+        t.elapsed().as_secs_f64()
+    );
 }

@@ -183,7 +183,9 @@ fn tiny_emitter() {
     };
     let s = solve(&scene, 0.05, 1e-4);
     assert_finite(&s);
-    let floor_h = polygon_results(&s.hierarchy, &s.solution)[box_faces(DVec3::ZERO, DVec3::ONE, true).iter().position(|(_, q)| q.iter().all(|p| p.z == 0.0)).unwrap()].h[0];
+    let floor_h = polygon_results(&s.hierarchy, &s.solution)
+        [box_faces(DVec3::ZERO, DVec3::ONE, true).iter().position(|(_, q)| q.iter().all(|p| p.z == 0.0)).unwrap()]
+    .h[0];
     assert!(floor_h > 0.0, "the floor is lit: H = {floor_h}");
 }
 
@@ -228,5 +230,8 @@ fn same_seed_gives_bit_identical_results_on_1_and_2_threads() {
     let (l1, b1) = run(1);
     let (l2, b2) = run(2);
     assert_eq!(l1, l2);
-    assert!(b1.iter().flatten().zip(b2.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits()), "radiosity differs between 1 and 2 threads");
+    assert!(
+        b1.iter().flatten().zip(b2.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits()),
+        "radiosity differs between 1 and 2 threads"
+    );
 }

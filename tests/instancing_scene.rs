@@ -69,7 +69,10 @@ fn nested_instances_flatten_with_their_transforms() {
     assert!((b.max.z - 1.0).abs() < 1e-12, "top of the first branch's leaf at z = 1, got {}", b.max.z);
     // Second branch's first leaf: translate (3,1,0) · rot z 90° · scale 0.5 of (0.1, 0, 1) → (3, 1.05, 0.5).
     let want = DVec3::new(3.0, 1.05, 0.5);
-    assert!(flat.polygons.iter().any(|p| p.poly.vertices().iter().any(|v| (*v - want).length() < 1e-12)), "transformed leaf vertex {want} not found");
+    assert!(
+        flat.polygons.iter().any(|p| p.poly.vertices().iter().any(|v| (*v - want).length() < 1e-12)),
+        "transformed leaf vertex {want} not found"
+    );
 }
 
 fn check_error(text: &str, expected: &str) {
@@ -102,7 +105,10 @@ fn instance_cycle_names_the_line_and_the_path() {
         "[[material]]\nname = \"w\"\nreflectance = 0.5\n[[prototype]]\nname = \"a\"\n[[prototype.instance]]\nof = \"b\"\n[[prototype]]\nname = \"b\"\n[[prototype.instance]]\nof = \"a\"\n[[instance]]\nof = \"a\"\n",
         "scene.toml:10: instance cycle: `a` -> `b` -> `a`",
     );
-    check_error("[[prototype]]\nname = \"self\"\n[[prototype.instance]]\nof = \"self\"\n", "scene.toml:3: instance cycle: `self` -> `self`");
+    check_error(
+        "[[prototype]]\nname = \"self\"\n[[prototype.instance]]\nof = \"self\"\n",
+        "scene.toml:3: instance cycle: `self` -> `self`",
+    );
 }
 
 #[test]
@@ -146,7 +152,11 @@ fn mini_poplar(dir: &Path) {
     std::fs::write(dir.join("tree_skeleton.obj"), "v 0 0 0\nv 0.3 0 0\nv 0 0 20\ng bark\nusemtl bark\nf 1 2 3\n").unwrap();
     std::fs::write(dir.join("ground.obj"), "v -32 -32 0\nv 32 -32 0\nv 32 32 0\nv -32 32 0\ng ground\nusemtl ground\nf 1 2 3 4\n").unwrap();
     let header = "# rows\nm00,m01,m02,m03,m10,m11,m12,m13,m20,m21,m22,m23\n";
-    std::fs::write(dir.join("tree_twig_instances.csv"), format!("{header}1,0,0,0.2,0,1,0,0,0,0,1,2\n0,-1,0,0,1,0,0,0.2,0,0,1,3\n0.8,0,0,0,0,0.8,0,0,0,0,0.8,4\n")).unwrap();
+    std::fs::write(
+        dir.join("tree_twig_instances.csv"),
+        format!("{header}1,0,0,0.2,0,1,0,0,0,0,1,2\n0,-1,0,0,1,0,0,0.2,0,0,1,3\n0.8,0,0,0,0,0.8,0,0,0,0,0.8,4\n"),
+    )
+    .unwrap();
     std::fs::write(dir.join("forest_tree_instances.csv"), format!("{header}1,0,0,-4,0,1,0,-4,0,0,1,0\n1,0,0,4,0,1,0,4,0,0,1,0\n")).unwrap();
 }
 

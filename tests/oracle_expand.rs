@@ -94,7 +94,12 @@ fn errors_are_collected_not_just_the_first() {
         "#,
     )
     .to_string();
-    for needle in ["unknown node `ghost`", "cycle: `a` -> `b` -> `a`", "node `lost` is unreachable from `start`", "does not handle answer(s) `Receiver`"] {
+    for needle in [
+        "unknown node `ghost`",
+        "cycle: `a` -> `b` -> `a`",
+        "node `lost` is unreachable from `start`",
+        "does not handle answer(s) `Receiver`",
+    ] {
         assert!(out.contains(needle), "missing {needle:?} in {out}");
     }
 }

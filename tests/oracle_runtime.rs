@@ -41,27 +41,42 @@ fn bf_file_and_bf_macro_are_the_same_graph() {
 #[test]
 fn graph_file_errors_name_file_line_and_node() {
     let head = "name = \"g\"\nstart = \"a\"\n";
-    let cycle = format!("{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\narms = [{{ on = \"Yes\", to = \"b\" }}, {{ on = \"No\", to = \"stop\" }}]\n[[node]]\nname = \"b\"\ntool = \"Larger\"\narms = [{{ on = \"Emitter\", to = \"a\" }}, {{ on = \"Receiver\", to = \"link\" }}]\n");
+    let cycle = format!(
+        "{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\narms = [{{ on = \"Yes\", to = \"b\" }}, {{ on = \"No\", to = \"stop\" }}]\n[[node]]\nname = \"b\"\ntool = \"Larger\"\narms = [{{ on = \"Emitter\", to = \"a\" }}, {{ on = \"Receiver\", to = \"link\" }}]\n"
+    );
     assert_eq!(file_error("cycle.toml", &cycle), "cycle.toml:10: cycle: `a` -> `b` -> `a`");
 
     let tool = format!("{head}[[node]]\nname = \"a\"\ntool = \"Facingg\"\narms = [{{ on = \"Yes\", to = \"link\" }}]\n");
     let e = file_error("tool.toml", &tool);
     assert!(e.starts_with("tool.toml:5: unknown tool `Facingg` (tools: BfAbove,"), "{e}");
 
-    let node = format!("{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\narms = [\n  {{ on = \"Yes\", to = \"link\" }},\n  {{ on = \"No\", to = \"elsewhere\" }},\n]\n");
+    let node = format!(
+        "{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\narms = [\n  {{ on = \"Yes\", to = \"link\" }},\n  {{ on = \"No\", to = \"elsewhere\" }},\n]\n"
+    );
     assert_eq!(file_error("node.toml", &node), "node.toml:8: unknown node `elsewhere`");
 
-    let unmapped = format!("{head}[[node]]\nname = \"a\"\ntool = \"CanSubdivide\"\nargs = [0.0]\narms = [{{ on = \"Neither | Both\", to = \"link\" }}]\n");
-    assert_eq!(file_error("unmapped.toml", &unmapped), "unmapped.toml:4: node `a` does not handle answer(s) `Emitter`, `Receiver` of `CanSubdivide`");
+    let unmapped = format!(
+        "{head}[[node]]\nname = \"a\"\ntool = \"CanSubdivide\"\nargs = [0.0]\narms = [{{ on = \"Neither | Both\", to = \"link\" }}]\n"
+    );
+    assert_eq!(
+        file_error("unmapped.toml", &unmapped),
+        "unmapped.toml:4: node `a` does not handle answer(s) `Emitter`, `Receiver` of `CanSubdivide`"
+    );
 
-    let foreign = format!("{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\narms = [{{ on = \"Yes | No\", to = \"link\" }}, {{ on = \"Maybe\", to = \"stop\" }}]\n");
+    let foreign = format!(
+        "{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\narms = [{{ on = \"Yes | No\", to = \"link\" }}, {{ on = \"Maybe\", to = \"stop\" }}]\n"
+    );
     assert_eq!(file_error("foreign.toml", &foreign), "foreign.toml:6: `Maybe` is not an answer of `Facing` (answers: Yes, No)");
 
     let syntax = "name = \"g\"\nstart = \n";
     assert!(file_error("syntax.toml", syntax).starts_with("syntax.toml:2: "), "{}", file_error("syntax.toml", syntax));
 
     let unknown_key = format!("{head}[[node]]\nname = \"a\"\ntool = \"Facing\"\nbranches = []\n");
-    assert!(file_error("key.toml", &unknown_key).starts_with("key.toml:6: unknown field `branches`"), "{}", file_error("key.toml", &unknown_key));
+    assert!(
+        file_error("key.toml", &unknown_key).starts_with("key.toml:6: unknown field `branches`"),
+        "{}",
+        file_error("key.toml", &unknown_key)
+    );
 }
 
 #[test]
@@ -125,12 +140,7 @@ fn statistics_and_trace_of_an_instrumented_run() {
 
 #[test]
 fn never_taken_branches_are_reported() {
-    let g = GraphBuilder::new("always")
-        .start("facing")
-        .node("facing", "Facing", &[])
-        .arm(&["Yes"], "link")
-        .arm(&["No"], "stop")
-        .build();
+    let g = GraphBuilder::new("always").start("facing").node("facing", "Facing", &[]).arm(&["Yes"], "link").arm(&["No"], "stop").build();
     let dag = DagOracle::with_probe(g.clone(), &[], Vec::new(), Recorder::new(1)).expect("valid");
     let scene = radiosity::scene::cornell_box();
     let _ = pipeline::run(&scene, &dag, &Config { max_passes: 1, ..Config::default() }, &|_| {});
@@ -148,7 +158,14 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
     let h = hierarchy::build(&scene, &BuildConfig::default());
     let caster = RayCaster::new(&scene);
     let radiosity = vec![[1.0; 3]; h.len()];
-    let services = Services { hierarchy: &h, caster: Some(&caster), visibility: VisibilityConfig::default(), radiosity: &radiosity, b_ref: 1.0, shafts: None };
+    let services = Services {
+        hierarchy: &h,
+        caster: Some(&caster),
+        visibility: VisibilityConfig::default(),
+        radiosity: &radiosity,
+        b_ref: 1.0,
+        shafts: None,
+    };
     let bf = DagOracle::new(parse_graph(BF_TOML, Path::new("bf.toml")).expect("valid"), &[]).expect("valid");
     let vis = GraphBuilder::new("vis")
         .start("v")

@@ -23,8 +23,21 @@ fn compare(scene: &Scene) -> f64 {
     let (a, b) = (polygon_results(&rays.hierarchy, &rays.solution), polygon_results(&shaft.hierarchy, &shaft.solution));
     let lit = |i: usize| !scene.materials[scene.polygons[i].material as usize].is_emitter();
     let max = (0..a.len()).filter(|&i| lit(i)).flat_map(|i| a[i].b).fold(0.0f64, f64::max);
-    let worst = (0..a.len()).filter(|&i| lit(i)).flat_map(|i| (0..3).map(move |c| (i, c))).map(|(i, c)| (a[i].b[c] - b[i].b[c]).abs()).fold(0.0f64, f64::max) / max;
-    println!("{}: rays {} links, shaft oracle {} links ({} invisible, {} visible without rays), worst difference {:.2}% of max", scene.name, rays.links.len(), shaft.links.len(), shaft.shaft_classified[0], shaft.shaft_classified[1], 100.0 * worst);
+    let worst = (0..a.len())
+        .filter(|&i| lit(i))
+        .flat_map(|i| (0..3).map(move |c| (i, c)))
+        .map(|(i, c)| (a[i].b[c] - b[i].b[c]).abs())
+        .fold(0.0f64, f64::max)
+        / max;
+    println!(
+        "{}: rays {} links, shaft oracle {} links ({} invisible, {} visible without rays), worst difference {:.2}% of max",
+        scene.name,
+        rays.links.len(),
+        shaft.links.len(),
+        shaft.shaft_classified[0],
+        shaft.shaft_classified[1],
+        100.0 * worst
+    );
     worst
 }
 

@@ -157,7 +157,14 @@ fn blocks(a: DVec3, b: DVec3, poly: &Poly, scale: f64) -> bool {
 
 /// Asserts that every segment between the point sets is blocked by some polygon of `scene` other
 /// than `skip`, testing the polygons of `first` (the claimed occluder) before the others.
-fn assert_all_blocked(scene: &Scene, pa: &[DVec3], pb: &[DVec3], skip: [Option<u32>; 2], first: &[u32], seed: u64) -> Result<(), TestCaseError> {
+fn assert_all_blocked(
+    scene: &Scene,
+    pa: &[DVec3],
+    pb: &[DVec3],
+    skip: [Option<u32>; 2],
+    first: &[u32],
+    seed: u64,
+) -> Result<(), TestCaseError> {
     let scale = scene.bounds().diagonal();
     let mut order: Vec<u32> = first.to_vec();
     order.extend((0..scene.polygons.len() as u32).filter(|k| !first.contains(k)));
@@ -245,7 +252,8 @@ fn generate(seed: u64, kind: Kind) -> (Scene, u32, u32) {
                 1 => (2, 2),
                 _ => (3, 1),
             };
-            let pt = |i: usize, j: usize| centre + u * (su * (2.0 * i as f64 / nu as f64 - 1.0)) + v * (sv * (2.0 * j as f64 / nv as f64 - 1.0));
+            let pt =
+                |i: usize, j: usize| centre + u * (su * (2.0 * i as f64 / nu as f64 - 1.0)) + v * (sv * (2.0 * j as f64 / nv as f64 - 1.0));
             for i in 0..nu {
                 for j in 0..nv {
                     let (a, b, cc, d) = (pt(i, j), pt(i + 1, j), pt(i + 1, j + 1), pt(i, j + 1));
@@ -260,7 +268,8 @@ fn generate(seed: u64, kind: Kind) -> (Scene, u32, u32) {
         }
         Kind::Behind => {
             // Below P (beyond P seen from Q), possibly reaching up through P's plane, or above Q.
-            let (z0, z1) = if g.chance(0.5) { (g.range(-2.0, -0.3), g.range(-0.2, 0.3)) } else { (h + g.range(-0.3, 0.2), h + g.range(0.3, 2.0)) };
+            let (z0, z1) =
+                if g.chance(0.5) { (g.range(-2.0, -0.3), g.range(-0.2, 0.3)) } else { (h + g.range(-0.3, 0.2), h + g.range(0.3, 2.0)) };
             let half = DVec3::new(g.range(0.2, 2.0), g.range(0.2, 2.0), 0.0);
             let rot = if g.chance(0.5) { DQuat::IDENTITY } else { DQuat::from_axis_angle(g.unit(), g.range(0.0, 0.4)) };
             c.solid_box(DVec3::new(-half.x, -half.y, z0), DVec3::new(half.x, half.y, z1), rot, "behind");
@@ -333,7 +342,10 @@ fn check_classify(kinds: &[Kind], cases: u32, salt: u64) -> (usize, usize) {
 
 fn report(name: &str, (cases, claims): (usize, usize), min_fraction: f64) {
     eprintln!("{name}: {claims} invisible claims in {cases} cases, all confirmed on {0}x{0} segments", GRID * GRID);
-    assert!(claims as f64 >= min_fraction * cases as f64, "{name}: only {claims} claims in {cases} cases: the property is barely exercised");
+    assert!(
+        claims as f64 >= min_fraction * cases as f64,
+        "{name}: only {claims} claims in {cases} cases: the property is barely exercised"
+    );
 }
 
 #[test]
@@ -492,7 +504,13 @@ fn candidate_lists_are_complete() {
                         prop_assert!(parent_list.contains(&(id as u32)), "seed {:#x}: object {} missing ({:?})", seed, id, volume);
                     }
                     if polygon_meets_shaft(poly, &child) {
-                        prop_assert!(child_list.contains(&(id as u32)), "seed {:#x}: object {} missing from child ({:?})", seed, id, volume);
+                        prop_assert!(
+                            child_list.contains(&(id as u32)),
+                            "seed {:#x}: object {} missing from child ({:?})",
+                            seed,
+                            id,
+                            volume
+                        );
                     }
                 }
             }

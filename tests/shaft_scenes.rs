@@ -30,8 +30,10 @@ fn check_scene(scene: &Scene) {
         let (pa, pb) = (&scene.polygons[a as usize].poly, &scene.polygons[b as usize].poly);
         pb.vertices().iter().any(|&v| pa.normal().dot(v - pa.v[0]) > 1e-9 * scale)
     };
-    let all: Vec<(u32, u32)> =
-        (0..n).flat_map(|a| (0..n).filter(move |&b| b != a).map(move |b| (a, b))).filter(|&(a, b)| in_front(a, b) && in_front(b, a)).collect();
+    let all: Vec<(u32, u32)> = (0..n)
+        .flat_map(|a| (0..n).filter(move |&b| b != a).map(move |b| (a, b)))
+        .filter(|&(a, b)| in_front(a, b) && in_front(b, a))
+        .collect();
     let stride = all.len().div_ceil(MAX_PAIRS).max(1);
     let pairs: Vec<(u32, u32)> = all.into_iter().step_by(stride).collect();
     let config = VisibilityConfig { rays: RAYS, seed: 3 };
@@ -43,7 +45,8 @@ fn check_scene(scene: &Scene) {
         let all_objects: Vec<u32> = (0..objects.len() as u32).collect();
         let (mut n_inv, mut n_vis, mut n_part, mut n_cand, mut max_diff, mut sum_diff) = (0usize, 0usize, 0usize, 0usize, 0.0f64, 0.0f64);
         let t0 = Instant::now();
-        let n_invisible_only = pairs.iter().filter(|&&(a, b)| shaft::classify(&objects, &h, a, b, None).class == ShaftClass::Invisible).count();
+        let n_invisible_only =
+            pairs.iter().filter(|&&(a, b)| shaft::classify(&objects, &h, a, b, None).class == ShaftClass::Invisible).count();
         let t_classify = t0.elapsed().as_secs_f64();
         let t0 = Instant::now();
         let mut rays = 0u64;

@@ -49,7 +49,9 @@ fn stairs_behind_beam_are_never_dark() {
     let light = (0..scene.polygons.len() as u32).find(|&i| scene.material_of(i as usize).is_emitter()).expect("the scene has a light");
     // Treads: the upward faces of the steps.
     let treads: Vec<u32> = (0..scene.polygons.len() as u32)
-        .filter(|&i| scene.groups[scene.polygons[i as usize].group as usize].starts_with("step") && scene.polygons[i as usize].poly.normal().y > 0.99)
+        .filter(|&i| {
+            scene.groups[scene.polygons[i as usize].group as usize].starts_with("step") && scene.polygons[i as usize].poly.normal().y > 0.99
+        })
         .collect();
     assert_eq!(treads.len(), 10, "one tread per step");
     for &t in &treads {
@@ -88,7 +90,11 @@ fn beam_hides_the_floor_below_it() {
     for _ in 0..5 {
         h.subdivide(id);
         let target = glam::DVec3::new(3.3, 0.0, 2.0);
-        id = *h.children_of(id).iter().min_by(|&&a, &&b| (h.get(a).center - target).length().total_cmp(&(h.get(b).center - target).length())).expect("4 children");
+        id = *h
+            .children_of(id)
+            .iter()
+            .min_by(|&&a, &&b| (h.get(a).center - target).length().total_cmp(&(h.get(b).center - target).length()))
+            .expect("4 children");
     }
     let verdict = shaft::classify(&objects, &h, light, id, None);
     assert_eq!(verdict.class, ShaftClass::Invisible, "floor element {:?} under the beam", h.get(id).bounds);

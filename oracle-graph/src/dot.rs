@@ -28,9 +28,10 @@ pub fn to_dot(graph: &Graph, labels: Option<&[String]>) -> String {
     let mut used: Vec<DecisionKind> = Vec::new();
     let mut note = |t: &Target| {
         if let Target::Decision(d) = t
-            && !used.contains(d) {
-                used.push(*d);
-            }
+            && !used.contains(d)
+        {
+            used.push(*d);
+        }
     };
     note(&graph.start);
     for n in graph.nodes.iter() {
@@ -46,7 +47,13 @@ pub fn to_dot(graph: &Graph, labels: Option<&[String]>) -> String {
     for n in graph.nodes.iter() {
         for arm in n.arms.iter() {
             let answers: Vec<&str> = arm.answers.iter().map(|a| &**a).collect();
-            let _ = writeln!(out, "    \"{}\" -> \"{}\" [label=\"{}\"];", escape(&n.name), escape(arm.target.word()), escape(&answers.join(" | ")));
+            let _ = writeln!(
+                out,
+                "    \"{}\" -> \"{}\" [label=\"{}\"];",
+                escape(&n.name),
+                escape(arm.target.word()),
+                escape(&answers.join(" | "))
+            );
         }
     }
     out.push_str("}\n");

@@ -38,8 +38,13 @@ pub enum DecisionKind {
 
 impl DecisionKind {
     /// Every decision, in declaration order.
-    pub const ALL: [DecisionKind; 5] =
-        [DecisionKind::Link, DecisionKind::SubdivideEmitter, DecisionKind::SubdivideReceiver, DecisionKind::SubdivideBoth, DecisionKind::Stop];
+    pub const ALL: [DecisionKind; 5] = [
+        DecisionKind::Link,
+        DecisionKind::SubdivideEmitter,
+        DecisionKind::SubdivideReceiver,
+        DecisionKind::SubdivideBoth,
+        DecisionKind::Stop,
+    ];
 
     /// The word that names the decision in a graph (`link`, `subdivide_emitter`, ...).
     #[must_use]

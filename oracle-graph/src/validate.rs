@@ -238,7 +238,13 @@ fn check_tools(cx: &mut Ctx<'_>, lookup: &dyn Fn(&str) -> ToolLookup) -> Vec<Opt
                     cx.error(
                         ErrorKind::ArgumentCount,
                         Site::Tool(id),
-                        format!("tool `{}` takes {} argument(s) ({}), found {}", info.name, info.args.len(), names.join(", "), n.tool.args.len()),
+                        format!(
+                            "tool `{}` takes {} argument(s) ({}), found {}",
+                            info.name,
+                            info.args.len(),
+                            names.join(", "),
+                            n.tool.args.len()
+                        ),
                     );
                 }
                 Some(info)
@@ -258,19 +264,32 @@ fn check_tools(cx: &mut Ctx<'_>, lookup: &dyn Fn(&str) -> ToolLookup) -> Vec<Opt
                     (Some(param), Some(spec)) if param.ty != spec.ty => cx.error(
                         ErrorKind::ArgumentType,
                         Site::Arg(id, k),
-                        format!("argument `{}` of `{}` is `{}`, parameter `{p}` is `{}`", spec.name, n.tool.name, spec.ty.rust_name(), param.ty.rust_name()),
+                        format!(
+                            "argument `{}` of `{}` is `{}`, parameter `{p}` is `{}`",
+                            spec.name,
+                            n.tool.name,
+                            spec.ty.rust_name(),
+                            param.ty.rust_name()
+                        ),
                     ),
                     _ => {}
                 },
                 Arg::Number(x) => {
                     if let Some(spec) = spec
-                        && spec.ty == crate::model::ParamType::U32 && !(x.fract() == 0.0 && *x >= 0.0 && *x <= f64::from(u32::MAX)) {
-                            cx.error(
-                                ErrorKind::ArgumentType,
-                                Site::Arg(id, k),
-                                format!("argument `{}` of `{}` is a count (`u32`), found {}", spec.name, n.tool.name, crate::model::format_number(*x)),
-                            );
-                        }
+                        && spec.ty == crate::model::ParamType::U32
+                        && !(x.fract() == 0.0 && *x >= 0.0 && *x <= f64::from(u32::MAX))
+                    {
+                        cx.error(
+                            ErrorKind::ArgumentType,
+                            Site::Arg(id, k),
+                            format!(
+                                "argument `{}` of `{}` is a count (`u32`), found {}",
+                                spec.name,
+                                n.tool.name,
+                                crate::model::format_number(*x)
+                            ),
+                        );
+                    }
                 }
             }
         }
@@ -293,18 +312,23 @@ fn check_answers(cx: &mut Ctx<'_>, tools: &[Option<&'static ToolInfo>]) -> Vec<V
         for (a, arm) in n.arms.iter().enumerate() {
             for (k, ans) in arm.answers.iter().enumerate() {
                 if seen.contains(&&**ans) {
-                    cx.error(ErrorKind::DuplicateAnswer, Site::Answer(id, a, k), format!("answer `{ans}` is handled twice in node `{}`", n.name));
+                    cx.error(
+                        ErrorKind::DuplicateAnswer,
+                        Site::Answer(id, a, k),
+                        format!("answer `{ans}` is handled twice in node `{}`", n.name),
+                    );
                 } else {
                     seen.push(ans);
                 }
                 if let Some(info) = tools[i]
-                    && info.answer_index(ans).is_none() {
-                        cx.error(
-                            ErrorKind::UnknownAnswer,
-                            Site::Answer(id, a, k),
-                            format!("`{ans}` is not an answer of `{}` (answers: {})", info.name, info.answers.join(", ")),
-                        );
-                    }
+                    && info.answer_index(ans).is_none()
+                {
+                    cx.error(
+                        ErrorKind::UnknownAnswer,
+                        Site::Answer(id, a, k),
+                        format!("`{ans}` is not an answer of `{}` (answers: {})", info.name, info.answers.join(", ")),
+                    );
+                }
             }
         }
         let mut map = Vec::new();
@@ -403,10 +427,11 @@ fn check_reachable(cx: &mut Ctx<'_>, start: Option<Resolved>, arms: &[Vec<Option
     while let Some(i) = todo.pop() {
         for t in arms[i].iter().flatten() {
             if let Resolved::Node(id) = t
-                && !seen[id.index()] {
-                    seen[id.index()] = true;
-                    todo.push(id.index());
-                }
+                && !seen[id.index()]
+            {
+                seen[id.index()] = true;
+                todo.push(id.index());
+            }
         }
     }
     for (i, s) in seen.iter().enumerate() {

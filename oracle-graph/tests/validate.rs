@@ -38,17 +38,11 @@ fn cycles_are_reported_once_with_their_path() {
 #[test]
 fn unknown_nodes_tools_params_and_answers() {
     check("oracle G { start => x; }", &[(ErrorKind::UnknownNode, "unknown node `x`")]);
-    check(
-        "oracle G { start => a; a: Facing { Yes => y, No => stop } }",
-        &[(ErrorKind::UnknownNode, "unknown node `y`")],
-    );
+    check("oracle G { start => a; a: Facing { Yes => y, No => stop } }", &[(ErrorKind::UnknownNode, "unknown node `y`")]);
     let unknown_tool = validate(&graph("oracle G { start => a; a: Nope { Yes => link } }"), &builtin_only).expect_err("unknown tool");
     assert_eq!(unknown_tool[0].kind, ErrorKind::UnknownTool);
     assert!(unknown_tool[0].message.starts_with("unknown tool `Nope` (tools: BfAbove,"), "{}", unknown_tool[0].message);
-    check(
-        "oracle G { start => a; a: BfAbove(eps) { Yes => link, No => stop } }",
-        &[(ErrorKind::UnknownParam, "unknown parameter `eps`")],
-    );
+    check("oracle G { start => a; a: BfAbove(eps) { Yes => link, No => stop } }", &[(ErrorKind::UnknownParam, "unknown parameter `eps`")]);
     check(
         "oracle G { start => a; a: BfAbove { Yes => link, No => stop } }",
         &[(ErrorKind::ArgumentCount, "tool `BfAbove` takes 1 argument(s) (eps), found 0")],
@@ -76,7 +70,9 @@ fn slots_are_those_of_the_tools_used() {
     use oracle_graph::Slot;
     let bf = graph("oracle G { params { eps: f64 = 0.1 } start => a; a: BfAbove(eps) { Yes => subdivide_both, No => link } }");
     assert_eq!(oracle_graph::catalogue::slots(&bf), [Slot::FormFactorMax]);
-    let vis = graph("oracle G { start => a; a: ReferenceVisibility { Visible => link, Invisible => stop, Partial => b } b: PreciseVisibility(64) { Done => link } }");
+    let vis = graph(
+        "oracle G { start => a; a: ReferenceVisibility { Visible => link, Invisible => stop, Partial => b } b: PreciseVisibility(64) { Done => link } }",
+    );
     assert_eq!(oracle_graph::catalogue::slots(&vis), [Slot::Visibility]);
 }
 
@@ -105,7 +101,10 @@ fn node_names_are_unique_reachable_and_not_decisions() {
     );
     check(
         "oracle G { start => a; a: Facing { Yes => link, No => stop } link: Facing { Yes => link, No => stop } }",
-        &[(ErrorKind::ReservedNodeName, "node name `link` is a decision word"), (ErrorKind::UnreachableNode, "node `link` is unreachable from `start`")],
+        &[
+            (ErrorKind::ReservedNodeName, "node name `link` is a decision word"),
+            (ErrorKind::UnreachableNode, "node `link` is unreachable from `start`"),
+        ],
     );
 }
 

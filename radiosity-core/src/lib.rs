@@ -11,15 +11,15 @@
 //! - [`output`]: `image.png`, `solution.ply`, `patches.csv`, `stats.json`
 #![warn(missing_docs)]
 
-pub mod geom;
-pub mod scene;
 pub mod analysis;
 pub mod formfactor;
+pub mod geom;
 pub mod hierarchy;
-pub mod visibility;
-pub mod refine;
-pub mod oracle;
-pub mod solve;
-pub mod pipeline;
-pub mod output;
 pub mod instancing;
+pub mod oracle;
+pub mod output;
+pub mod pipeline;
+pub mod refine;
+pub mod scene;
+pub mod solve;
+pub mod visibility;

@@ -145,13 +145,19 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
     let shaft_objects = match config.visibility_method {
-        VisibilityMethod::Shafts(volume) if use_visibility => {
-            Some(crate::visibility::shaft::ShaftObjects::new(scene, &crate::visibility::shaft::ObjectConfig { volume, ..Default::default() }))
-        }
+        VisibilityMethod::Shafts(volume) if use_visibility => Some(crate::visibility::shaft::ShaftObjects::new(
+            scene,
+            &crate::visibility::shaft::ObjectConfig { volume, ..Default::default() },
+        )),
         _ => None,
     };
     let (shaft_rays, shaft_invisible, shaft_visible) = (AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0));
-    let shafts = shaft_objects.as_ref().map(|objects| refine::ShaftServices { objects, rays: &shaft_rays, invisible: &shaft_invisible, visible: &shaft_visible });
+    let shafts = shaft_objects.as_ref().map(|objects| refine::ShaftServices {
+        objects,
+        rays: &shaft_rays,
+        invisible: &shaft_invisible,
+        visible: &shaft_visible,
+    });
     let mut timings = Timings { build: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
     let mut radiosity = initial_radiosity(&h);
@@ -218,7 +224,22 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let error_estimate = Some(solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
-    Solved { hierarchy: h, links, solution, caster, refine_stats: stats, rays, passes, leaf_entries, shaft_classified, traits, left_out, error_estimate, iterations, timings }
+    Solved {
+        hierarchy: h,
+        links,
+        solution,
+        caster,
+        refine_stats: stats,
+        rays,
+        passes,
+        leaf_entries,
+        shaft_classified,
+        traits,
+        left_out,
+        error_estimate,
+        iterations,
+        timings,
+    }
 }
 
 /// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene
@@ -257,4 +278,3 @@ fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
     }
     b
 }
-

@@ -121,11 +121,7 @@ fn renderpark_reference(name: &str) -> Option<(&'static str, &'static str)> {
 
 fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
     args.options.validate()?;
-    let scenes = if args.scenes.is_empty() {
-        vec!["cornell".to_string()]
-    } else {
-        args.scenes.clone()
-    };
+    let scenes = if args.scenes.is_empty() { vec!["cornell".to_string()] } else { args.scenes.clone() };
     let exe = std::env::current_exe().context("locating this executable")?;
     let tmp = std::env::temp_dir().join(format!("radiosity-bench-{}", std::process::id()));
     let mut rows = Vec::new();
@@ -135,11 +131,7 @@ fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
     for (i, scene) in scenes.iter().enumerate() {
         let out = tmp.join(format!("{i}"));
         let mut cmd = Command::new(&exe);
-        cmd.arg("solve")
-            .arg("--quiet")
-            .arg("--no-image")
-            .arg("--out")
-            .arg(&out);
+        cmd.arg("solve").arg("--quiet").arg("--no-image").arg("--out").arg(&out);
         if scene != "cornell" {
             let p = PathBuf::from(scene);
             anyhow::ensure!(p.exists(), "{scene}: no such file");
@@ -162,15 +154,11 @@ fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
         if o.common.no_visibility {
             cmd.arg("--no-visibility");
         }
-        let status = cmd
-            .status()
-            .with_context(|| format!("running {}", exe.display()))?;
+        let status = cmd.status().with_context(|| format!("running {}", exe.display()))?;
         anyhow::ensure!(status.success(), "{scene}: solve failed ({status})");
         let path = out.join("stats.json");
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("{}: cannot read", path.display()))?;
-        let stats: serde_json::Value = serde_json::from_str(&text)
-            .with_context(|| format!("{}: invalid JSON", path.display()))?;
+        let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let stats: serde_json::Value = serde_json::from_str(&text).with_context(|| format!("{}: invalid JSON", path.display()))?;
         if !args.json {
             print_row(scene, &stats);
         }
@@ -213,10 +201,7 @@ fn print_header() {
 }
 
 fn print_row(scene: &str, s: &serde_json::Value) {
-    let name = std::path::Path::new(scene)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or(scene);
+    let name = std::path::Path::new(scene).file_name().and_then(|n| n.to_str()).unwrap_or(scene);
     let t = &s["time_s"];
     let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
     let rp = renderpark_reference(name).map_or("-".to_string(), |(t, m)| format!("{t} / {m}"));
@@ -297,7 +282,13 @@ fn bench_oracle(args: &OracleBenchArgs) -> anyhow::Result<()> {
 }
 
 /// Solves `scene` in a child process into `out` and returns its `stats.json`.
-fn child_solve(exe: &std::path::Path, scene: &str, o: &SolveOptions, visibility: &str, out: &std::path::Path) -> anyhow::Result<serde_json::Value> {
+fn child_solve(
+    exe: &std::path::Path,
+    scene: &str,
+    o: &SolveOptions,
+    visibility: &str,
+    out: &std::path::Path,
+) -> anyhow::Result<serde_json::Value> {
     let mut cmd = Command::new(exe);
     cmd.arg("solve").arg("--quiet").arg("--no-image").arg("--out").arg(out);
     if !super::GENERATED_SCENES.contains(&scene) {
@@ -305,7 +296,16 @@ fn child_solve(exe: &std::path::Path, scene: &str, o: &SolveOptions, visibility:
         anyhow::ensure!(p.exists(), "{scene}: no such file");
     }
     cmd.arg(scene);
-    cmd.args(["--eps", &o.eps.to_string(), "--rays", &o.common.rays.to_string(), "--seed", &o.common.seed.to_string(), "--min-area", &o.common.min_area.to_string()]);
+    cmd.args([
+        "--eps",
+        &o.eps.to_string(),
+        "--rays",
+        &o.common.rays.to_string(),
+        "--seed",
+        &o.common.seed.to_string(),
+        "--min-area",
+        &o.common.min_area.to_string(),
+    ]);
     cmd.args(["--visibility", visibility]);
     if o.common.allow_dark {
         cmd.arg("--allow-dark");
@@ -322,12 +322,16 @@ fn child_solve(exe: &std::path::Path, scene: &str, o: &SolveOptions, visibility:
 
 fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
     args.options.validate()?;
-    let scenes: Vec<String> = if args.scenes.is_empty() { super::GENERATED_SCENES.iter().map(|s| s.to_string()).collect() } else { args.scenes.clone() };
+    let scenes: Vec<String> =
+        if args.scenes.is_empty() { super::GENERATED_SCENES.iter().map(|s| s.to_string()).collect() } else { args.scenes.clone() };
     let exe = std::env::current_exe().context("locating this executable")?;
     let tmp = std::env::temp_dir().join(format!("radiosity-bench-shafts-{}", std::process::id()));
     let mut rows = Vec::new();
     if !args.json {
-        println!("{:<18} {:<5} {:>9} {:>9} {:>11} {:>9} {:>9} {:>10} {:>8}", "scene", "method", "links", "elements", "rays", "time_s", "peak_MB", "max_diff", "speedup");
+        println!(
+            "{:<18} {:<5} {:>9} {:>9} {:>11} {:>9} {:>9} {:>10} {:>8}",
+            "scene", "method", "links", "elements", "rays", "time_s", "peak_MB", "max_diff", "speedup"
+        );
     }
     for (i, scene) in scenes.iter().enumerate() {
         let mut reference: Option<(Vec<[f64; 3]>, f64)> = None;
@@ -335,7 +339,9 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
             let out = tmp.join(format!("{i}-{method}"));
             let s = child_solve(&exe, scene, &args.options, method, &out)?;
             let b = super::read_patches(&out.join("patches.csv"))?;
-            let time = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN) + s["time_s"]["build"].as_f64().unwrap_or(0.0) + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
+            let time = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN)
+                + s["time_s"]["build"].as_f64().unwrap_or(0.0)
+                + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
             let (diff, speedup) = match &reference {
                 None => {
                     reference = Some((b, time));
@@ -360,7 +366,10 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
                     s["links"].as_u64().unwrap_or(0),
                     s["elements"].as_u64().unwrap_or(0),
                     s["rays"].as_u64().unwrap_or(0),
-                    time, s["peak_rss_bytes"].as_f64().unwrap_or(f64::NAN) / 1e6, diff, speedup
+                    time,
+                    s["peak_rss_bytes"].as_f64().unwrap_or(f64::NAN) / 1e6,
+                    diff,
+                    speedup
                 );
             }
             rows.push(row);
@@ -405,7 +414,18 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     for method in ["instanced", "full"] {
         let file = dir.join(format!("radiosity-bench-instancing-{method}-{}.bin", std::process::id()));
         let o = Command::new(&exe)
-            .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string(), "--eps", &args.eps.to_string(), "--child", method])
+            .args([
+                "bench",
+                "instancing",
+                "--age",
+                &args.age.to_string(),
+                "--seed",
+                &args.seed.to_string(),
+                "--eps",
+                &args.eps.to_string(),
+                "--child",
+                method,
+            ])
             .arg(&file)
             .output()
             .with_context(|| format!("running {}", exe.display()))?;

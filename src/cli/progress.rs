@@ -35,7 +35,9 @@ impl Reporter {
         let msg = match p {
             Progress::Refine { pass, links, pending } => format!("refine pass {pass}: {links} links, {pending} candidates pending"),
             Progress::LeafSolve { entries } => format!("leaf-resolution solve: {entries} coefficients"),
-            Progress::Solved { pass, iterations, residual } => format!("solve pass {pass}: {iterations} iterations, residual {residual:.1e}"),
+            Progress::Solved { pass, iterations, residual } => {
+                format!("solve pass {pass}: {iterations} iterations, residual {residual:.1e}")
+            }
         };
         self.bar.set_message(msg);
     }

@@ -67,7 +67,8 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         "visibility": !args.options.common.no_visibility,
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
-    let out_config = OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
+    let out_config =
+        OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
     // Write once to measure the output time, then rewrite stats.json with the final figures.
     output::write_all(&args.out, &scene, &solved, &stats, &out_config)?;
     stats.time_s.output = t_out.elapsed().as_secs_f64();
@@ -112,7 +113,11 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         println!("left out: {}", s.left_out.join("; "));
     }
     if let Some(e) = s.error_estimate {
-        println!("error estimate: {:.2}% of the largest radiosity (one-step residual against a full-resolution gather), in {:.3}s", 100.0 * e, s.time_s.total);
+        println!(
+            "error estimate: {:.2}% of the largest radiosity (one-step residual against a full-resolution gather), in {:.3}s",
+            100.0 * e,
+            s.time_s.total
+        );
     }
     println!("power: emitted {:.6e} W, absorbed {:.6e} W (ratio {:.5})", s.power_emitted, s.power_absorbed, balance);
     println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());
@@ -138,10 +143,14 @@ fn solve_instanced(args: &SolveArgs) -> anyhow::Result<()> {
     doc["time_s"] = serde_json::json!({ "total": t0.elapsed().as_secs_f64() });
     doc["peak_rss_bytes"] = serde_json::json!(output::peak_rss_bytes());
     let stats_path = args.out.join("stats.json");
-    std::fs::write(&stats_path, serde_json::to_string_pretty(&doc)? + "\n").with_context(|| format!("{}: cannot write", stats_path.display()))?;
+    std::fs::write(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
+        .with_context(|| format!("{}: cannot write", stats_path.display()))?;
     if !args.quiet {
         println!("{}", serde_json::to_string_pretty(&doc)?);
-        println!("wrote {0}/solution.ply and {0}/stats.json (image.png and patches.csv are not written for instanced scenes yet)", args.out.display());
+        println!(
+            "wrote {0}/solution.ply and {0}/stats.json (image.png and patches.csv are not written for instanced scenes yet)",
+            args.out.display()
+        );
     }
     Ok(())
 }

@@ -79,7 +79,12 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         }
         (path, _) => super::read_patches(Path::new(path))?,
     };
-    anyhow::ensure!(reference.len() == scene.polygons.len(), "reference has {} polygons, the scene {}", reference.len(), scene.polygons.len());
+    anyhow::ensure!(
+        reference.len() == scene.polygons.len(),
+        "reference has {} polygons, the scene {}",
+        reference.len(),
+        scene.polygons.len()
+    );
     let max_ref = reference.iter().flatten().fold(0.0f64, |m, v| m.max(*v)).max(f64::MIN_POSITIVE);
     let areas: Vec<f64> = scene.polygons.iter().map(|p| p.poly.area()).collect();
     let total_area: f64 = areas.iter().sum();
@@ -113,7 +118,11 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
                 solved.rays
             )?;
             if !args.quiet {
-                println!("{name} eps {eps}: {time:.3}s, {} links, error {pct:.3}% of max (estimate {:.3}%)", solved.links.len(), 100.0 * est);
+                println!(
+                    "{name} eps {eps}: {time:.3}s, {} links, error {pct:.3}% of max (estimate {:.3}%)",
+                    solved.links.len(),
+                    100.0 * est
+                );
             }
             points.push((name.clone(), time, pct, 100.0 * est));
         }
@@ -199,18 +208,36 @@ fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> String {
     }
     let sx = |v: f64| m + (lx(v) - x0) / (x1 - x0) * (w - 1.5 * m);
     let sy = |v: f64| h - m - (lx(v) - y0) / (y1 - y0) * (h - 1.7 * m);
-    let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n");
+    let mut s =
+        format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n");
     let _ = writeln!(s, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
     let _ = writeln!(s, "<text x=\"{}\" y=\"20\" text-anchor=\"middle\">{}: error against run time</text>", w / 2.0, xml(scene));
     let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">run time (s, log)</text>", w / 2.0, h - 12.0);
-    let _ = writeln!(s, "<text x=\"14\" y=\"{}\" transform=\"rotate(-90 14 {})\" text-anchor=\"middle\">error, % of max (log); hollow: estimate</text>", h / 2.0, h / 2.0);
+    let _ = writeln!(
+        s,
+        "<text x=\"14\" y=\"{}\" transform=\"rotate(-90 14 {})\" text-anchor=\"middle\">error, % of max (log); hollow: estimate</text>",
+        h / 2.0,
+        h / 2.0
+    );
     for k in x0 as i32..=x1 as i32 {
         let x = sx(10f64.powi(k));
-        let _ = writeln!(s, "<line x1=\"{x}\" y1=\"{}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{k}</text>", m * 0.7, h - m, h - m + 16.0);
+        let _ = writeln!(
+            s,
+            "<line x1=\"{x}\" y1=\"{}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{k}</text>",
+            m * 0.7,
+            h - m,
+            h - m + 16.0
+        );
     }
     for k in y0 as i32..=y1 as i32 {
         let y = sy(10f64.powi(k));
-        let _ = writeln!(s, "<line x1=\"{m}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>", w - m / 2.0, m - 6.0, y + 4.0);
+        let _ = writeln!(
+            s,
+            "<line x1=\"{m}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>",
+            w - m / 2.0,
+            m - 6.0,
+            y + 4.0
+        );
     }
     const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
     let mut names: Vec<&str> = pos.iter().map(|p| p.0.as_str()).collect();

@@ -30,7 +30,10 @@ fn embedded_cornell_box_has_no_nan_and_b_at_least_e() {
     }
     assert!(n > 100, "only {n} leaves: the oracle did not refine");
     // Something is lit besides the lamp.
-    let lit = h.leaves().filter(|&l| h.emission[h.get(l).polygon().unwrap() as usize][0] == 0.0 && solved.solution.radiosity[l as usize][0] > 0.0).count();
+    let lit = h
+        .leaves()
+        .filter(|&l| h.emission[h.get(l).polygon().unwrap() as usize][0] == 0.0 && solved.solution.radiosity[l as usize][0] > 0.0)
+        .count();
     assert!(lit > n / 2, "{lit} of {n} leaves lit");
 }
 

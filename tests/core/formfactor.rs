@@ -57,7 +57,9 @@ fn point_to_rectangle_on_the_corner_normal() {
         let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
         (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
     };
-    for (a, b, c, tabulated) in [(1.0, 1.0, 1.0, 0.138_531_605_994_893), (2.0, 1.0, 1.0, 0.167_375_009_914_384), (1.0, 1.0, 0.25, 0.237_856_030_646_370)] {
+    for (a, b, c, tabulated) in
+        [(1.0, 1.0, 1.0, 0.138_531_605_994_893), (2.0, 1.0, 1.0, 0.167_375_009_914_384), (1.0, 1.0, 0.25, 0.237_856_030_646_370)]
+    {
         let rect = [v(0., 0., c), v(0., b, c), v(a, b, c), v(a, 0., c)]; // faces −z, toward the point
         let f = point_polygon(DVec3::ZERO, DVec3::Z, &rect, -DVec3::Z);
         assert!((f - closed(a, b, c)).abs() < POINT_ABS_TOL, "{a}×{b} at {c}: {f} vs closed form {}", closed(a, b, c));

@@ -13,7 +13,8 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 const MTL: &str = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 10 10 10\n";
-const GOOD_FACES: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nusemtl white\nf 1 2 3 4\nusemtl lamp\nf 5 6 7 8\n";
+const GOOD_FACES: &str =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nusemtl white\nf 1 2 3 4\nusemtl lamp\nf 5 6 7 8\n";
 
 fn load_err(path: &Path, allow_dark: bool) -> String {
     match load(path, &LoadOptions { allow_dark }) {

@@ -125,10 +125,11 @@ fn check_param(p: &ParamDecl, errors: &mut Errors) -> Option<Param> {
     };
     let param = Param { name: Cow::Owned(p.name.to_string()), ty, value };
     if let (ParamValueDecl::Fixed { default, .. }, ParamValue::Fixed { default: d, .. }) = (&p.value, &param.value)
-        && let Err(msg) = param.check(*d) {
-            // Kept in the graph so its uses are not reported as unknown too.
-            errors.push(syn::Error::new_spanned(&default.tokens, format!("default of {msg}")));
-        }
+        && let Err(msg) = param.check(*d)
+    {
+        // Kept in the graph so its uses are not reported as unknown too.
+        errors.push(syn::Error::new_spanned(&default.tokens, format!("default of {msg}")));
+    }
     Some(param)
 }
 
@@ -144,9 +145,16 @@ fn node_of(n: &NodeDecl) -> Node {
     let arms = n
         .arms
         .iter()
-        .map(|a| Arm { answers: Cow::Owned(a.answers.iter().map(|x| Cow::Owned(x.to_string())).collect()), target: Target::parse(&a.target.to_string()) })
+        .map(|a| Arm {
+            answers: Cow::Owned(a.answers.iter().map(|x| Cow::Owned(x.to_string())).collect()),
+            target: Target::parse(&a.target.to_string()),
+        })
         .collect::<Vec<_>>();
-    Node { name: Cow::Owned(n.name.to_string()), tool: ToolRef { name: Cow::Owned(path_name(&n.tool)), args: Cow::Owned(args) }, arms: Cow::Owned(arms) }
+    Node {
+        name: Cow::Owned(n.name.to_string()),
+        tool: ToolRef { name: Cow::Owned(path_name(&n.tool)), args: Cow::Owned(args) },
+        arms: Cow::Owned(arms),
+    }
 }
 
 fn site_span(decl: &OracleDecl, nodes: &[&NodeDecl], site: Site) -> proc_macro2::Span {
@@ -169,9 +177,10 @@ pub fn doc_text(attrs: &[syn::Attribute]) -> String {
     for a in attrs {
         if let syn::Meta::NameValue(nv) = &a.meta
             && nv.path.is_ident("doc")
-                && let syn::Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
-                    lines.push(s.value().trim().to_owned());
-                }
+            && let syn::Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value
+        {
+            lines.push(s.value().trim().to_owned());
+        }
     }
     lines.join(" ").trim().to_owned()
 }

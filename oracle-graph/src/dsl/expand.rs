@@ -153,12 +153,7 @@ fn node_body(k: &TokenStream, m: &OracleModel<'_>, i: usize) -> TokenStream {
             quote!(#p)
         }
     };
-    let args: Vec<TokenStream> = node
-        .args
-        .iter()
-        .enumerate()
-        .map(|(a, arg)| arg_code(m, info.map(|t| t.args[a].ty), arg))
-        .collect();
+    let args: Vec<TokenStream> = node.args.iter().enumerate().map(|(a, arg)| arg_code(m, info.map(|t| t.args[a].ty), arg)).collect();
     let tool_expr = if node.args.is_empty() { tool_path.clone() } else { quote!(#tool_path(#(#args),*)) };
     let alias = format_ident!("__OracleAnswer_{}", node.name);
     let arms: Vec<TokenStream> = node

@@ -176,7 +176,8 @@ impl Parse for Item {
         let name: Ident = input.parse()?;
         let content;
         braced!(content in input);
-        let mut decl = OracleDecl { attrs, vis, keyword, name, params: Vec::new(), uses: Vec::new(), starts: Vec::new(), nodes: Vec::new() };
+        let mut decl =
+            OracleDecl { attrs, vis, keyword, name, params: Vec::new(), uses: Vec::new(), starts: Vec::new(), nodes: Vec::new() };
         while !content.is_empty() {
             if content.peek(kw::params) && content.peek2(syn::token::Brace) {
                 content.parse::<kw::params>()?;
@@ -278,11 +279,7 @@ impl Parse for NodeDecl {
 
 impl Parse for ArgDecl {
     fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
-        if input.peek(Ident) {
-            Ok(ArgDecl::Param(input.parse()?))
-        } else {
-            Ok(ArgDecl::Number(input.parse()?))
-        }
+        if input.peek(Ident) { Ok(ArgDecl::Param(input.parse()?)) } else { Ok(ArgDecl::Number(input.parse()?)) }
     }
 }
 

@@ -79,7 +79,10 @@ pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: Form
         (PolyKind::Triangle, x) if x >= FAR_SEPARATION => &quadrature::TRI_3,
         (PolyKind::Triangle, _) => &quadrature::TRI_6,
     };
-    if separation < NEAR_SEPARATION && wholly_in_front(rp.vertices(), sp.vertices(), s.normal, s.radius) && wholly_in_front(sv, rp.vertices(), r.normal, r.radius) {
+    if separation < NEAR_SEPARATION
+        && wholly_in_front(rp.vertices(), sp.vertices(), s.normal, s.radius)
+        && wholly_in_front(sv, rp.vertices(), r.normal, r.radius)
+    {
         // Near pairs wholly in front of each other (touching walls included): Stokes' double
         // contour integral, exact up to 1e-11 and cheap where receiver quadrature struggles with
         // the log-singular derivatives at a shared edge.
@@ -187,7 +190,13 @@ pub fn projected_area(h: &Hierarchy, e: &Element, dir: DVec3) -> f64 {
             if members.len() > CLUSTER_EXACT_MAX_POLYGONS {
                 return 0.25 * e.area;
             }
-            members.iter().map(|&p| { let el = h.get(p); el.area * el.normal.dot(dir).max(0.0) }).sum()
+            members
+                .iter()
+                .map(|&p| {
+                    let el = h.get(p);
+                    el.area * el.normal.dot(dir).max(0.0)
+                })
+                .sum()
         }
     }
 }

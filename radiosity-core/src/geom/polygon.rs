@@ -99,9 +99,7 @@ impl Poly {
     pub fn point(&self, s: f64, t: f64) -> DVec3 {
         match self.kind {
             PolyKind::Triangle => self.v[0] + s * (self.v[1] - self.v[0]) + t * (self.v[2] - self.v[0]),
-            PolyKind::Quad => {
-                (1.0 - s) * (1.0 - t) * self.v[0] + s * (1.0 - t) * self.v[1] + s * t * self.v[2] + (1.0 - s) * t * self.v[3]
-            }
+            PolyKind::Quad => (1.0 - s) * (1.0 - t) * self.v[0] + s * (1.0 - t) * self.v[1] + s * t * self.v[2] + (1.0 - s) * t * self.v[3],
         }
     }
 
@@ -143,12 +141,7 @@ impl Poly {
                 let m23 = 0.5 * (v[2] + v[3]);
                 let m30 = 0.5 * (v[3] + v[0]);
                 let c = self.point(0.5, 0.5);
-                [
-                    Poly::quad(v[0], m01, c, m30),
-                    Poly::quad(m01, v[1], m12, c),
-                    Poly::quad(c, m12, v[2], m23),
-                    Poly::quad(m30, c, m23, v[3]),
-                ]
+                [Poly::quad(v[0], m01, c, m30), Poly::quad(m01, v[1], m12, c), Poly::quad(c, m12, v[2], m23), Poly::quad(m30, c, m23, v[3])]
             }
         }
     }

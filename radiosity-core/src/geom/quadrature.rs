@@ -21,9 +21,15 @@ const W3: [f64; 3] = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
 macro_rules! gauss3x3 {
     () => {
         [
-            (G3[0], G3[0]), (G3[1], G3[0]), (G3[2], G3[0]),
-            (G3[0], G3[1]), (G3[1], G3[1]), (G3[2], G3[1]),
-            (G3[0], G3[2]), (G3[1], G3[2]), (G3[2], G3[2]),
+            (G3[0], G3[0]),
+            (G3[1], G3[0]),
+            (G3[2], G3[0]),
+            (G3[0], G3[1]),
+            (G3[1], G3[1]),
+            (G3[2], G3[1]),
+            (G3[0], G3[2]),
+            (G3[1], G3[2]),
+            (G3[2], G3[2]),
         ]
     };
 }
@@ -31,16 +37,23 @@ macro_rules! gauss3x3 {
 pub const QUAD_9: Rule = Rule {
     points: &gauss3x3!(),
     weights: &[
-        W3[0] * W3[0], W3[1] * W3[0], W3[2] * W3[0],
-        W3[0] * W3[1], W3[1] * W3[1], W3[2] * W3[1],
-        W3[0] * W3[2], W3[1] * W3[2], W3[2] * W3[2],
+        W3[0] * W3[0],
+        W3[1] * W3[0],
+        W3[2] * W3[0],
+        W3[0] * W3[1],
+        W3[1] * W3[1],
+        W3[2] * W3[1],
+        W3[0] * W3[2],
+        W3[1] * W3[2],
+        W3[2] * W3[2],
     ],
 };
 
 /// Centroid rule for triangles (1 point).
 pub const TRI_1: Rule = Rule { points: &[(1.0 / 3.0, 1.0 / 3.0)], weights: &[1.0] };
 /// 3-point rule for triangles, degree 2 (interior points).
-pub const TRI_3: Rule = Rule { points: &[(1.0 / 6.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 6.0), (1.0 / 6.0, 2.0 / 3.0)], weights: &[1.0 / 3.0; 3] };
+pub const TRI_3: Rule =
+    Rule { points: &[(1.0 / 6.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 6.0), (1.0 / 6.0, 2.0 / 3.0)], weights: &[1.0 / 3.0; 3] };
 
 const T6A: f64 = 0.445_948_490_915_965;
 const T6B: f64 = 0.091_576_213_509_771;
@@ -48,10 +61,7 @@ const T6WA: f64 = 0.223_381_589_678_011;
 const T6WB: f64 = 0.109_951_743_655_322;
 /// 6-point rule for triangles, degree 4 (Dunavant).
 pub const TRI_6: Rule = Rule {
-    points: &[
-        (T6A, T6A), (1.0 - 2.0 * T6A, T6A), (T6A, 1.0 - 2.0 * T6A),
-        (T6B, T6B), (1.0 - 2.0 * T6B, T6B), (T6B, 1.0 - 2.0 * T6B),
-    ],
+    points: &[(T6A, T6A), (1.0 - 2.0 * T6A, T6A), (T6A, 1.0 - 2.0 * T6A), (T6B, T6B), (1.0 - 2.0 * T6B, T6B), (T6B, 1.0 - 2.0 * T6B)],
     weights: &[T6WA, T6WA, T6WA, T6WB, T6WB, T6WB],
 };
 

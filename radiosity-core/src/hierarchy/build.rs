@@ -82,10 +82,7 @@ fn build_cluster(h: &mut Hierarchy, centroids: &[DVec3], start: usize, end: usiz
         h.cluster_polygons[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
             centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis]).then(a.cmp(&b))
         });
-        vec![
-            build_cluster(h, centroids, start, mid, depth + 1, max_leaf),
-            build_cluster(h, centroids, mid, end, depth + 1, max_leaf),
-        ]
+        vec![build_cluster(h, centroids, start, mid, depth + 1, max_leaf), build_cluster(h, centroids, mid, end, depth + 1, max_leaf)]
     };
     let child_start = h.children.len() as u32;
     let mut bounds = Aabb::EMPTY;

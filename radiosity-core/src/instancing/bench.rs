@@ -46,7 +46,11 @@ pub fn bench_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(B
 /// Solves `scene` with instances and measures it. With `keep_means` the per-polygon means are kept
 /// for comparison (memory linear in the polygons, 32 bytes each); without, the solve streams to
 /// nothing and only the figures are returned.
-pub fn bench_instanced(scene: &InstancedScene, config: &InstancedConfig, keep_means: bool) -> Result<(BenchRow, Option<PolygonMeans>), InstancingError> {
+pub fn bench_instanced(
+    scene: &InstancedScene,
+    config: &InstancedConfig,
+    keep_means: bool,
+) -> Result<(BenchRow, Option<PolygonMeans>), InstancingError> {
     struct Discard;
     impl super::solver::RadiositySink for Discard {
         fn polygon(&mut self, _: u64, _: u32, _: &[(crate::geom::Poly, [f64; 3])]) -> Result<(), InstancingError> {

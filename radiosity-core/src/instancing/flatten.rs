@@ -35,7 +35,13 @@ pub fn reversed(p: &Poly) -> Poly {
 /// Calls `f(poly, material, prototype)` for every polygon of prototype `id` placed by `transform`,
 /// in flattening order: own polygons first (each two-sided one followed by its back twin when
 /// `options.two_sided_pairs`), then each instance's polygons, recursively, depth-first.
-pub fn for_each_polygon(scene: &InstancedScene, id: PrototypeId, transform: &Transform, options: &FlattenOptions, f: &mut dyn FnMut(Poly, u32, PrototypeId)) {
+pub fn for_each_polygon(
+    scene: &InstancedScene,
+    id: PrototypeId,
+    transform: &Transform,
+    options: &FlattenOptions,
+    f: &mut dyn FnMut(Poly, u32, PrototypeId),
+) {
     let mut stack: Vec<(PrototypeId, Transform)> = vec![(id, *transform)];
     while let Some((pid, t)) = stack.pop() {
         let p = scene.prototype(pid);
@@ -59,7 +65,12 @@ pub fn flatten(scene: &InstancedScene, options: &FlattenOptions) -> Result<Scene
 }
 
 /// Prototype `id` placed by `transform`, as plain polygons.
-pub fn flatten_prototype(scene: &InstancedScene, id: PrototypeId, transform: &Transform, options: &FlattenOptions) -> Result<Scene, InstancingError> {
+pub fn flatten_prototype(
+    scene: &InstancedScene,
+    id: PrototypeId,
+    transform: &Transform,
+    options: &FlattenOptions,
+) -> Result<Scene, InstancingError> {
     let mut b = SceneBuilder::new(&scene.path, &scene.name);
     for m in &scene.materials {
         let _ = b.material(m.clone())?;

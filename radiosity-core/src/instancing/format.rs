@@ -204,12 +204,25 @@ pub fn parse(text: &str, path: &Path, dir: &Path) -> Result<InstancedScene, Inst
     let root = match &spec.root {
         Some(r) => {
             if has_top {
-                return Err(InstancingError::at(path, line_of(r.span().start), "`root` and top-level geometry or instances cannot be combined"));
+                return Err(InstancingError::at(
+                    path,
+                    line_of(r.span().start),
+                    "`root` and top-level geometry or instances cannot be combined",
+                ));
             }
-            *names.get(r.get_ref()).ok_or_else(|| InstancingError::at(path, line_of(r.span().start), format!("unknown prototype `{}`", r.get_ref())))?
+            *names
+                .get(r.get_ref())
+                .ok_or_else(|| InstancingError::at(path, line_of(r.span().start), format!("unknown prototype `{}`", r.get_ref())))?
         }
         None => {
-            prototypes.push(ctx.prototype(TOP_LEVEL_NAME, spec.obj.as_ref(), &spec.materials, &spec.boxes, &spec.polygon, &spec.instance)?);
+            prototypes.push(ctx.prototype(
+                TOP_LEVEL_NAME,
+                spec.obj.as_ref(),
+                &spec.materials,
+                &spec.boxes,
+                &spec.polygon,
+                &spec.instance,
+            )?);
             (prototypes.len() - 1) as PrototypeId
         }
     };
@@ -255,9 +268,18 @@ impl Ctx<'_> {
             let line = self.line(obj.span().start);
             let file = self.dir.join(obj.get_ref());
             if !file.is_file() {
-                return Err(InstancingError::at(self.path, line, format!("prototype `{name}`: missing prototype file `{}`", file.display())));
+                return Err(InstancingError::at(
+                    self.path,
+                    line,
+                    format!("prototype `{name}`: missing prototype file `{}`", file.display()),
+                ));
             }
-            let mesh = obj_mesh::read(&file).map_err(|source| InstancingError::Prototype { path: self.path.to_owned(), line, prototype: name.to_owned(), source })?;
+            let mesh = obj_mesh::read(&file).map_err(|source| InstancingError::Prototype {
+                path: self.path.to_owned(),
+                line,
+                prototype: name.to_owned(),
+                source,
+            })?;
             let target = |k: usize| renames.get(&mesh.materials[k].name).map_or(mesh.materials[k].name.as_str(), String::as_str).to_owned();
             let map: Vec<Option<u32>> = (0..mesh.materials.len()).map(|k| self.material(&target(k), line).ok()).collect();
             for p in &mesh.polygons {
@@ -266,7 +288,11 @@ impl Ctx<'_> {
                     InstancingError::at(
                         self.path,
                         line,
-                        format!("prototype `{name}`: material `{}` used in `{}` is not defined in the scene file", target(k), file.display()),
+                        format!(
+                            "prototype `{name}`: material `{}` used in `{}` is not defined in the scene file",
+                            target(k),
+                            file.display()
+                        ),
                     )
                 })?;
                 out.polygons.push(LocalPolygon { poly: p.poly, material });
@@ -305,7 +331,10 @@ impl Ctx<'_> {
         for is in instances {
             let line = self.line(is.span().start);
             let s = is.get_ref();
-            let prototype = *self.names.get(&s.of).ok_or_else(|| InstancingError::at(self.path, line, format!("instance of unknown prototype `{}`", s.of)))?;
+            let prototype = *self
+                .names
+                .get(&s.of)
+                .ok_or_else(|| InstancingError::at(self.path, line, format!("instance of unknown prototype `{}`", s.of)))?;
             let transform = instance_transform(s).map_err(|msg| InstancingError::at(self.path, line, msg))?;
             if let Some(d) = transform.defect() {
                 return Err(InstancingError::at(self.path, line, format!("instance of `{}`: {d}", s.of)));
@@ -336,9 +365,5 @@ pub fn instance_transform(s: &InstanceSpec) -> Result<Transform, String> {
         Some(ScaleSpec::Uniform(k)) => DVec3::splat(k),
         Some(ScaleSpec::Axes(a)) => DVec3::from_array(a),
     };
-    Ok(Transform::from_trs(
-        DVec3::from_array(s.translate.unwrap_or([0.0; 3])),
-        DVec3::from_array(s.rotate.unwrap_or([0.0; 3])),
-        scale,
-    ))
+    Ok(Transform::from_trs(DVec3::from_array(s.translate.unwrap_or([0.0; 3])), DVec3::from_array(s.rotate.unwrap_or([0.0; 3])), scale))
 }

@@ -58,6 +58,6 @@ pub use error::InstancingError;
 pub use flatten::{FlattenOptions, flatten, flatten_prototype};
 pub use format::{load, parse};
 pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
-pub use solver::{InstancedConfig, InstancedStats, PlyStream, PolygonMeans, RadiositySink, solve_full, solve_instanced};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};
+pub use solver::{InstancedConfig, InstancedStats, PlyStream, PolygonMeans, RadiositySink, solve_full, solve_instanced};
 pub use write::write_scene;

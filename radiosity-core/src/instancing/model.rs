@@ -210,7 +210,11 @@ impl InstancedScene {
             }
             for inst in &p.instances {
                 if inst.prototype as usize >= n {
-                    return Err(InstancingError::at(&self.path, inst.line, format!("prototype `{}`: instance of an unknown prototype", p.name)));
+                    return Err(InstancingError::at(
+                        &self.path,
+                        inst.line,
+                        format!("prototype `{}`: instance of an unknown prototype", p.name),
+                    ));
                 }
                 if let Some(d) = inst.transform.defect() {
                     return Err(InstancingError::at(
@@ -267,7 +271,8 @@ impl InstancedScene {
         let mut counts = vec![0u64; self.prototypes.len()];
         for id in self.bottom_up() {
             let p = &self.prototypes[id as usize];
-            let own: u64 = p.polygons.iter().map(|q| if two_sided_pairs && self.materials[q.material as usize].two_sided { 2 } else { 1 }).sum();
+            let own: u64 =
+                p.polygons.iter().map(|q| if two_sided_pairs && self.materials[q.material as usize].two_sided { 2 } else { 1 }).sum();
             let sub: u64 = p.instances.iter().map(|i| counts[i.prototype as usize]).sum();
             counts[id as usize] = own.saturating_add(sub);
         }
@@ -319,7 +324,8 @@ fn find_cycle(scene: &InstancedScene) -> Option<(usize, String)> {
                     }
                     1 => {
                         let from = stack.iter().position(|&(q, _)| q == c).unwrap_or(0);
-                        let mut names: Vec<String> = stack[from..].iter().map(|&(q, _)| format!("`{}`", scene.prototypes[q].name)).collect();
+                        let mut names: Vec<String> =
+                            stack[from..].iter().map(|&(q, _)| format!("`{}`", scene.prototypes[q].name)).collect();
                         names.push(format!("`{}`", scene.prototypes[c].name));
                         return Some((inst.line, names.join(" -> ")));
                     }

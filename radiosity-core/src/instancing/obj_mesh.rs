@@ -38,7 +38,11 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 }
                 let v = DVec3::from_array(c);
                 if !v.is_finite() {
-                    return Err(SceneError::NonFinite { path: path.to_owned(), line: line_no, what: format!("vertex {}", vertices.len() + 1) });
+                    return Err(SceneError::NonFinite {
+                        path: path.to_owned(),
+                        line: line_no,
+                        what: format!("vertex {}", vertices.len() + 1),
+                    });
                 }
                 vertices.push(v);
             }

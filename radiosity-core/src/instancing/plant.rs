@@ -156,7 +156,11 @@ impl PlantLibrary {
                         let phi = 137.5f64.to_radians() * (j * p.twigs_per_node + k) as f64 + 0.4 * (rng.next_f64() - 0.5);
                         let tilt = (45.0 + 20.0 * rng.next_f64()).to_radians();
                         let z = (j as f64 + (k as f64 + 0.5) / p.twigs_per_node as f64) * len;
-                        proto.instances.push(Instance { prototype: child, transform: placement(z, phi, tilt, 0.9 + 0.2 * rng.next_f64()), line: 0 });
+                        proto.instances.push(Instance {
+                            prototype: child,
+                            transform: placement(z, phi, tilt, 0.9 + 0.2 * rng.next_f64()),
+                            line: 0,
+                        });
                     }
                 }
             }
@@ -171,7 +175,11 @@ impl PlantLibrary {
                         let phi = 77f64.to_radians() * (j * p.branches_per_node + k) as f64 + 0.3 * (rng.next_f64() - 0.5);
                         let tilt = (p.branch_angle_deg + 8.0 * (rng.next_f64() - 0.5)).to_radians();
                         let z = (j as f64 + (k as f64 + 0.5) / p.branches_per_node as f64) * len;
-                        proto.instances.push(Instance { prototype: child, transform: placement(z, phi, tilt, 0.9 + 0.2 * rng.next_f64()), line: 0 });
+                        proto.instances.push(Instance {
+                            prototype: child,
+                            transform: placement(z, phi, tilt, 0.9 + 0.2 * rng.next_f64()),
+                            line: 0,
+                        });
                     }
                 }
             }
@@ -197,7 +205,12 @@ impl PlantLibrary {
         let g = self.material(GROUND);
         let l = self.material(LIGHT);
         let mut polygons = vec![LocalPolygon {
-            poly: Poly::quad(DVec3::new(-half, -half, 0.0), DVec3::new(half, -half, 0.0), DVec3::new(half, half, 0.0), DVec3::new(-half, half, 0.0)),
+            poly: Poly::quad(
+                DVec3::new(-half, -half, 0.0),
+                DVec3::new(half, -half, 0.0),
+                DVec3::new(half, half, 0.0),
+                DVec3::new(-half, half, 0.0),
+            ),
             material: g,
         }];
         let s = 0.15 * top.max(half);
@@ -205,7 +218,8 @@ impl PlantLibrary {
             let a = 2.0 * PI * k as f64 / N_LIGHTS as f64;
             let c = DVec3::new(0.6 * half * a.cos(), 0.6 * half * a.sin(), top);
             // CCW about -z: the light faces down.
-            let poly = Poly::quad(c + DVec3::new(-s, -s, 0.0), c + DVec3::new(-s, s, 0.0), c + DVec3::new(s, s, 0.0), c + DVec3::new(s, -s, 0.0));
+            let poly =
+                Poly::quad(c + DVec3::new(-s, -s, 0.0), c + DVec3::new(-s, s, 0.0), c + DVec3::new(s, s, 0.0), c + DVec3::new(s, -s, 0.0));
             polygons.push(LocalPolygon { poly, material: l });
         }
         Prototype { name: "scene".into(), polygons, instances, source: None }
@@ -227,7 +241,8 @@ fn placement(z: f64, phi: f64, tilt: f64, scale: f64) -> Transform {
 /// azimuth `phi`, raised by `tilt`.
 fn leaf_quad(z: f64, phi: f64, tilt: f64, scale: f64) -> Poly {
     let (l, w) = (0.06 * scale, 0.04 * scale);
-    let t = glam::DMat4::from_translation(DVec3::new(0.0, 0.0, z)) * glam::DMat4::from_rotation_z(phi) * glam::DMat4::from_rotation_y(-tilt);
+    let t =
+        glam::DMat4::from_translation(DVec3::new(0.0, 0.0, z)) * glam::DMat4::from_rotation_z(phi) * glam::DMat4::from_rotation_y(-tilt);
     let p = |x: f64, y: f64| t.transform_point3(DVec3::new(x + 0.004, y, 0.0));
     Poly::quad(p(0.0, 0.0), p(0.5 * l, -0.5 * w), p(l, 0.0), p(0.5 * l, 0.5 * w))
 }
@@ -261,7 +276,8 @@ pub fn generate_tree_with(age: u32, seed: u64, params: &TreeParams) -> Instanced
     let mut lib = PlantLibrary::new(&format!("tree-a{age}-s{seed}"), *params, seed);
     let trunk = lib.axis(AxisKind::Trunk, age);
     let height = params.trunk_internode * age as f64;
-    let root = lib.stage(0.5 * height.max(2.0), 1.5 * height + 1.0, vec![Instance { prototype: trunk, transform: Transform::IDENTITY, line: 0 }]);
+    let root =
+        lib.stage(0.5 * height.max(2.0), 1.5 * height + 1.0, vec![Instance { prototype: trunk, transform: Transform::IDENTITY, line: 0 }]);
     lib.finish(root)
 }
 

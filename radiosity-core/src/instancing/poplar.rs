@@ -40,16 +40,35 @@ pub fn poplar_toml(source_dir: &Path, obj_dir: &str, forest: bool) -> Result<Str
     let trees = if forest { read_matrices(&source_dir.join("forest_tree_instances.csv"))? } else { Vec::new() };
     let obj = |f: &str| if obj_dir.is_empty() { f.to_owned() } else { format!("{}/{f}", obj_dir.trim_end_matches('/')) };
     let mut s = String::with_capacity(200 * (twigs.len() + trees.len()) + 2000);
-    let _ = writeln!(s, "# Synthetic poplar (instanced_poplar): twig x {} on the skeleton{}", twigs.len(), if forest { ", 8 x 8 forest" } else { "" });
+    let _ = writeln!(
+        s,
+        "# Synthetic poplar (instanced_poplar): twig x {} on the skeleton{}",
+        twigs.len(),
+        if forest { ", 8 x 8 forest" } else { "" }
+    );
     let _ = writeln!(s, "name = \"{}\"", if forest { "poplar-forest" } else { "poplar" });
     let _ = writeln!(s, "obj = \"{}\"\n", obj("ground.obj"));
     let _ = writeln!(s, "[[material]]\nname = \"bark\"\nreflectance = [0.32, 0.27, 0.22]\n");
-    let _ = writeln!(s, "[[material]]\nname = \"leaf\"\nreflectance = [0.18, 0.38, 0.12]\ntransmittance = [0.12, 0.30, 0.08]\ntwo_sided = true\n");
+    let _ = writeln!(
+        s,
+        "[[material]]\nname = \"leaf\"\nreflectance = [0.18, 0.38, 0.12]\ntransmittance = [0.12, 0.30, 0.08]\ntwo_sided = true\n"
+    );
     let _ = writeln!(s, "[[material]]\nname = \"ground\"\nreflectance = [0.25, 0.22, 0.18]\n");
     let _ = writeln!(s, "[[material]]\nname = \"light\"\nreflectance = 0.0\nemission = 10.0\n");
     for (x, y, h) in POPLAR_LIGHTS {
         let z = POPLAR_LIGHT_HEIGHT;
-        let _ = writeln!(s, "[[polygon]]\nmaterial = \"light\"\nvertices = [[{}, {}, {z}], [{}, {}, {z}], [{}, {}, {z}], [{}, {}, {z}]]\n", x - h, y - h, x - h, y + h, x + h, y + h, x + h, y - h);
+        let _ = writeln!(
+            s,
+            "[[polygon]]\nmaterial = \"light\"\nvertices = [[{}, {}, {z}], [{}, {}, {z}], [{}, {}, {z}], [{}, {}, {z}]]\n",
+            x - h,
+            y - h,
+            x - h,
+            y + h,
+            x + h,
+            y + h,
+            x + h,
+            y - h
+        );
     }
     if forest {
         for m in &trees {

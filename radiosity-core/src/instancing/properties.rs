@@ -17,9 +17,9 @@
 //! prototype lit by a large distant emitter ([`crate::pipeline::run`] with [`crate::refine::BfHand`];
 //! one-sided and two-sided-as-pairs surfaces, no transmittance).
 
+use super::InstancingError;
 use super::flatten::{FlattenOptions, flatten_prototype};
 use super::model::{InstancedScene, PrototypeId, Transform};
-use super::InstancingError;
 use crate::geom::{Aabb, DVec3};
 use crate::pipeline;
 use crate::refine::{BfHand, BfParams};
@@ -455,7 +455,8 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, _a_eff: f64, eps: f64
         if cos > 0.0 {
             let mut clear = 0u32;
             for s in 0..k * k {
-                let x = p.poly.sample((f64::from(s % k) + 0.5) / f64::from(k), (f64::from(s / k) + 0.5) / f64::from(k)) + n * (RAY_OFFSET_REL * diag);
+                let x = p.poly.sample((f64::from(s % k) + 0.5) / f64::from(k), (f64::from(s / k) + 0.5) / f64::from(k))
+                    + n * (RAY_OFFSET_REL * diag);
                 if caster.segment_clear(x, x + w * (2.0 * diag), i as u32, u32::MAX) {
                     clear += 1;
                 }
@@ -537,7 +538,8 @@ impl PropertyCache {
         let key = cache_key(hashes[id as usize], config);
         let path = self.entry_path(name, &key);
         if let Ok(text) = std::fs::read_to_string(&path) {
-            let props: RadiativeProperties = serde_json::from_str(&text).map_err(|e| InstancingError::Cache { path: path.clone(), msg: e.to_string() })?;
+            let props: RadiativeProperties =
+                serde_json::from_str(&text).map_err(|e| InstancingError::Cache { path: path.clone(), msg: e.to_string() })?;
             if props.key == key {
                 return Ok((props, CacheOutcome::Hit));
             }

@@ -19,10 +19,10 @@
 //! computation and every local problem bounded. Memory is bounded by the largest local problem plus
 //! six irradiance values per pending instance; the flattened scene is never built.
 
+use super::InstancingError;
 use super::flatten::{FlattenOptions, reversed};
 use super::model::{InstancedScene, PrototypeId, Transform};
 use super::properties::{CacheOutcome, PropertyCache, PropertyConfig, RadiativeProperties, content_hashes};
-use super::InstancingError;
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
 use crate::pipeline;
@@ -176,7 +176,8 @@ impl PlyStream {
         let header = format!("ply\nformat ascii 1.0\nelement vertex {:0w$}\n", n_vertices, w = PLY_COUNT_WIDTH);
         file.seek(std::io::SeekFrom::Start(0)).map_err(|e| io(&path, e))?;
         file.write_all(header.as_bytes()).map_err(|e| io(&path, e))?;
-        let offset = header.len() + "property double x\nproperty double y\nproperty double z\nproperty float r\nproperty float g\nproperty float b\n".len();
+        let offset = header.len()
+            + "property double x\nproperty double y\nproperty double z\nproperty float r\nproperty float g\nproperty float b\n".len();
         file.seek(std::io::SeekFrom::Start(offset as u64)).map_err(|e| io(&path, e))?;
         file.write_all(format!("element face {:0w$}\n", n_faces, w = PLY_COUNT_WIDTH).as_bytes()).map_err(|e| io(&path, e))?;
         let _ = std::fs::remove_file(&faces_path);
@@ -190,7 +191,8 @@ impl RadiositySink for PlyStream {
         for (p, b) in leaves {
             let vs = p.vertices();
             for v in vs {
-                writeln!(self.file, "{} {} {} {} {} {}", v.x, v.y, v.z, b[0] as f32, b[1] as f32, b[2] as f32).map_err(|e| io(&self.path, e))?;
+                writeln!(self.file, "{} {} {} {} {} {}", v.x, v.y, v.z, b[0] as f32, b[1] as f32, b[2] as f32)
+                    .map_err(|e| io(&self.path, e))?;
             }
             write!(self.faces, "{}", vs.len()).map_err(|e| io(&self.faces_path, e))?;
             for k in 0..vs.len() as u64 {
@@ -231,7 +233,11 @@ enum Role {
 
 /// Solves `scene` depth-first with instances (see the module docs), streaming every finished
 /// flattened polygon to `sink`.
-pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn RadiositySink) -> Result<InstancedStats, InstancingError> {
+pub fn solve_instanced(
+    scene: &InstancedScene,
+    config: &InstancedConfig,
+    sink: &mut dyn RadiositySink,
+) -> Result<InstancedStats, InstancingError> {
     let t0 = std::time::Instant::now();
     scene.validate()?;
     let counts = scene.flattened_counts(true);
@@ -345,7 +351,14 @@ pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &
         // each carrying the irradiance its exit face received in the parent. Its first reflection
         // becomes the polygon's emission; the local solve adds every further interreflection.
         let external = match &task.incoming {
-            Some(field) => incoming_irradiance(&local, &bounds[task.prototype as usize], &task.transform, field, config.incoming_rays, config.properties.seed),
+            Some(field) => incoming_irradiance(
+                &local,
+                &bounds[task.prototype as usize],
+                &task.transform,
+                field,
+                config.incoming_rays,
+                config.properties.seed,
+            ),
             None => Vec::new(),
         };
         if !external.is_empty() {
@@ -429,7 +442,14 @@ pub fn solve_instanced(scene: &InstancedScene, config: &InstancedConfig, sink: &
 
 /// Irradiance from outside of every polygon of `local` (see the module docs). `lb` is the opened
 /// prototype's local box, `t` its placement, `field` the irradiance received by its proxy's faces.
-fn incoming_irradiance(local: &crate::scene::Scene, lb: &Aabb, t: &Transform, field: &[[f64; 3]; 6], rays: u32, seed: u64) -> Vec<[f64; 3]> {
+fn incoming_irradiance(
+    local: &crate::scene::Scene,
+    lb: &Aabb,
+    t: &Transform,
+    field: &[[f64; 3]; 6],
+    rays: u32,
+    seed: u64,
+) -> Vec<[f64; 3]> {
     use rayon::prelude::*;
     let caster = crate::visibility::RayCaster::new(local);
     let inv = t.matrix.inverse();

@@ -30,11 +30,8 @@ struct OutPrototype {
 /// own polygons; returns the TOML path. Creates `dir` if needed.
 pub fn write_scene(scene: &InstancedScene, dir: &Path, stem: &str) -> Result<PathBuf, InstancingError> {
     std::fs::create_dir_all(dir).map_err(|e| InstancingError::io(dir, "cannot create folder", e))?;
-    let names: Vec<String> = scene
-        .prototypes
-        .iter()
-        .map(|p| if p.name == TOP_LEVEL_NAME { unique_name(scene, "scene") } else { p.name.clone() })
-        .collect();
+    let names: Vec<String> =
+        scene.prototypes.iter().map(|p| if p.name == TOP_LEVEL_NAME { unique_name(scene, "scene") } else { p.name.clone() }).collect();
     let material = scene
         .materials
         .iter()
@@ -59,12 +56,17 @@ pub fn write_scene(scene: &InstancedScene, dir: &Path, stem: &str) -> Result<Pat
         let instance = p
             .instances
             .iter()
-            .map(|i| InstanceSpec { of: names[i.prototype as usize].clone(), matrix: Some(i.transform.to_rows_3x4().to_vec()), ..InstanceSpec::default() })
+            .map(|i| InstanceSpec {
+                of: names[i.prototype as usize].clone(),
+                matrix: Some(i.transform.to_rows_3x4().to_vec()),
+                ..InstanceSpec::default()
+            })
             .collect();
         prototype.push(OutPrototype { name: name.clone(), obj, instance });
     }
     let out = OutFile { name: scene.name.clone(), root: names[scene.root as usize].clone(), material, prototype };
-    let text = toml::to_string(&out).map_err(|e| InstancingError::at(&dir.join(format!("{stem}.toml")), 0, format!("cannot encode scene: {e}")))?;
+    let text = toml::to_string(&out)
+        .map_err(|e| InstancingError::at(&dir.join(format!("{stem}.toml")), 0, format!("cannot encode scene: {e}")))?;
     let path = dir.join(format!("{stem}.toml"));
     let header = "# Scene with instances (radiosity instancing format): materials, prototypes (OBJ + instances), root.\n";
     std::fs::write(&path, format!("{header}{text}")).map_err(|e| InstancingError::io(&path, "cannot write file", e))?;

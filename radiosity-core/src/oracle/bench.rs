@@ -58,7 +58,9 @@ impl BenchRow {
 #[must_use]
 pub fn same_solution(a: &Solved, b: &Solved) -> bool {
     let bits = |s: &Solved| -> Vec<u64> { s.solution.radiosity.iter().flat_map(|c| c.iter().map(|x| x.to_bits())).collect() };
-    let links = |s: &Solved| -> Vec<(u32, u32, u64, u64)> { s.links.iter().map(|l| (l.source, l.receiver, l.ff.to_bits(), l.vis.to_bits())).collect() };
+    let links = |s: &Solved| -> Vec<(u32, u32, u64, u64)> {
+        s.links.iter().map(|l| (l.source, l.receiver, l.ff.to_bits(), l.vis.to_bits())).collect()
+    };
     a.links.len() == b.links.len() && links(a) == links(b) && bits(a) == bits(b)
 }
 
@@ -98,7 +100,10 @@ pub fn run(scenes: &[Scene], config: &BenchConfig) -> Vec<BenchRow> {
 /// The rows as a table: scene, links, times, and ratios to the hand-written release.
 #[must_use]
 pub fn format_table(rows: &[BenchRow]) -> String {
-    let mut out = format!("{:<20} {:>8} {:>10} {:>10} {:>8} {:>10} {:>8} {:>9}\n", "scene", "links", "hand (s)", "dag (s)", "dag/hand", "flat (s)", "flat/hand", "identical");
+    let mut out = format!(
+        "{:<20} {:>8} {:>10} {:>10} {:>8} {:>10} {:>8} {:>9}\n",
+        "scene", "links", "hand (s)", "dag (s)", "dag/hand", "flat (s)", "flat/hand", "identical"
+    );
     for r in rows {
         out.push_str(&format!(
             "{:<20} {:>8} {:>10.4} {:>10.4} {:>8.3} {:>10.4} {:>8.3} {:>9}\n",

@@ -75,7 +75,9 @@ pub struct ParamError {
 pub fn check_param(graph: &graph::Graph, name: &str, value: f64) -> Result<(), ParamError> {
     match graph.param(name) {
         Some(p) => p.check(value).map_err(|message| ParamError { message }),
-        None => Err(ParamError { message: format!("unknown parameter `{name}` of oracle `{}` (parameters: {})", graph.name, param_list(graph)) }),
+        None => Err(ParamError {
+            message: format!("unknown parameter `{name}` of oracle `{}` (parameters: {})", graph.name, param_list(graph)),
+        }),
     }
 }
 

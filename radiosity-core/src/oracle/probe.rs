@@ -112,7 +112,9 @@ impl Recorder {
             .zip(&self.counters)
             .map(|(node, c)| {
                 let names: &[&str] = c.names.get().copied().unwrap_or(&[]);
-                let count = |name: &str| names.iter().position(|n| *n == name).map_or(0, |i| c.answers[i.min(MAX_ANSWERS - 1)].load(Ordering::Relaxed));
+                let count = |name: &str| {
+                    names.iter().position(|n| *n == name).map_or(0, |i| c.answers[i.min(MAX_ANSWERS - 1)].load(Ordering::Relaxed))
+                };
                 let answers = names.iter().map(|n| ((*n).to_owned(), count(n))).collect();
                 let never_taken = node
                     .arms

@@ -58,7 +58,8 @@ pub fn write_all(dir: &Path, scene: &Scene, solved: &Solved, stats: &Stats, conf
     if config.image {
         let path = dir.join("image.png");
         let rgb = render(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &config.render);
-        write_png(&path, &rgb, config.render.width, config.render.height).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+        write_png(&path, &rgb, config.render.width, config.render.height)
+            .map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
     }
 
     let path = dir.join("stats.json");

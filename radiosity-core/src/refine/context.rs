@@ -103,7 +103,13 @@ impl<'a> LinkCtx<'a> {
         if let Some((class, _)) = &self.shaft {
             return Some(*class);
         }
-        let v = crate::visibility::shaft::classify(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, self.parent_candidates.as_deref());
+        let v = crate::visibility::shaft::classify(
+            shafts.objects,
+            self.services.hierarchy,
+            self.emitter,
+            self.receiver,
+            self.parent_candidates.as_deref(),
+        );
         self.shaft = Some((v.class, std::sync::Arc::from(v.candidates)));
         Some(v.class)
     }
@@ -182,7 +188,8 @@ impl<'a> LinkCtx<'a> {
                     ShaftClass::Partial { .. } => {
                         let config = VisibilityConfig { rays, ..self.services.visibility };
                         let cands = self.shaft_candidates().expect("classified above");
-                        let (v, n) = shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &cands, &config);
+                        let (v, n) =
+                            shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &cands, &config);
                         shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
                         v
                     }

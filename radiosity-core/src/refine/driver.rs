@@ -157,7 +157,14 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
     }
 }
 
-fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, c: &Candidate, d: Decision, cands: Option<Arc<[u32]>>, next: &mut Vec<Candidate>) {
+fn split(
+    h: &mut Hierarchy,
+    radiosity: &mut Vec<[f64; 3]>,
+    c: &Candidate,
+    d: Decision,
+    cands: Option<Arc<[u32]>>,
+    next: &mut Vec<Candidate>,
+) {
     let mut children_of = |h: &mut Hierarchy, id: ElementId| -> Vec<ElementId> {
         if h.get(id).n_children == 0 {
             h.subdivide(id);

@@ -223,7 +223,12 @@ fn triangulate(vs: &[DVec3]) -> Vec<[usize; 3]> {
                 continue;
             }
             let inside = idx.iter().any(|&q| {
-                q != a && q != b && q != c && cross(p[a], p[b], p[q]) >= 0.0 && cross(p[b], p[c], p[q]) >= 0.0 && cross(p[c], p[a], p[q]) >= 0.0
+                q != a
+                    && q != b
+                    && q != c
+                    && cross(p[a], p[b], p[q]) >= 0.0
+                    && cross(p[b], p[c], p[q]) >= 0.0
+                    && cross(p[c], p[a], p[q]) >= 0.0
             });
             if inside {
                 continue;

@@ -71,7 +71,12 @@ impl Gen {
         self.solid(DVec3::new(x - w / 2.0, y0 + h - t, z - d / 2.0), DVec3::new(x + w / 2.0, y0 + h, z + d / 2.0), mat, "table top");
         for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
             let (cx, cz) = (x + sx * (w / 2.0 - leg), z + sz * (d / 2.0 - leg));
-            self.solid(DVec3::new(cx - leg / 2.0, y0, cz - leg / 2.0), DVec3::new(cx + leg / 2.0, y0 + h - t, cz + leg / 2.0), mat, "table leg");
+            self.solid(
+                DVec3::new(cx - leg / 2.0, y0, cz - leg / 2.0),
+                DVec3::new(cx + leg / 2.0, y0 + h - t, cz + leg / 2.0),
+                mat,
+                "table leg",
+            );
         }
     }
 

@@ -4,10 +4,10 @@
 mod builder;
 mod cornell;
 mod error;
+pub mod generated;
 pub mod mgf;
 mod obj;
 pub mod shapes;
-pub mod generated;
 
 pub use builder::SceneBuilder;
 pub use cornell::cornell_box;

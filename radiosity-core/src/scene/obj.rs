@@ -121,7 +121,11 @@ fn prescan(text: &str, path: &Path) -> Result<Vec<usize>, SceneError> {
                 for w in &coords[..3] {
                     let x: f64 = w.parse().map_err(|_| err(line_no, format!("vertex coordinate `{w}` is not a number")))?;
                     if !x.is_finite() {
-                        return Err(SceneError::NonFinite { path: path.to_owned(), line: line_no, what: format!("vertex {}", n_vertices + 1) });
+                        return Err(SceneError::NonFinite {
+                            path: path.to_owned(),
+                            line: line_no,
+                            what: format!("vertex {}", n_vertices + 1),
+                        });
                     }
                 }
                 n_vertices += 1;

@@ -32,9 +32,5 @@ pub fn box_faces(lo: DVec3, hi: DVec3, inward: bool) -> Vec<(&'static str, [DVec
         ("z-", [p(0., 0., 0.), p(0., 1., 0.), p(1., 1., 0.), p(1., 0., 0.)]),
         ("z+", [p(0., 0., 1.), p(1., 0., 1.), p(1., 1., 1.), p(0., 1., 1.)]),
     ];
-    if inward {
-        faces.into_iter().map(|(n, [a, b, c, d])| (n, [a, d, c, b])).collect()
-    } else {
-        faces
-    }
+    if inward { faces.into_iter().map(|(n, [a, b, c, d])| (n, [a, d, c, b])).collect() } else { faces }
 }

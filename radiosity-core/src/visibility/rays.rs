@@ -93,11 +93,8 @@ impl RayCaster {
             }
         }
         let mut core_time = std::time::Duration::ZERO;
-        let bvh = if tris.is_empty() {
-            CwBvh::default()
-        } else {
-            build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core_time)
-        };
+        let bvh =
+            if tris.is_empty() { CwBvh::default() } else { build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core_time) };
         // Reorder triangles into BVH primitive order so the callback indexes them directly.
         let (triangles, tri_polygon) = bvh.primitive_indices.iter().map(|&i| (tris[i as usize], owner[i as usize])).unzip();
         RayCaster { bvh, triangles, tri_polygon, center, inv_scale, rays_cast: AtomicU64::new(0) }
@@ -172,7 +169,13 @@ impl RayCaster {
 /// and the occlusion vary together (contact shadows); the plain fraction is returned when no segment
 /// carries weight. Deterministic for a given seed, independent of thread scheduling; every caster
 /// (the global BVH, shaft candidate lists) samples the same segments through this function.
-pub fn sampled_visibility(h: &Hierarchy, source: u32, receiver: u32, config: &VisibilityConfig, mut clear: impl FnMut(DVec3, DVec3, u32, u32) -> bool) -> f64 {
+pub fn sampled_visibility(
+    h: &Hierarchy,
+    source: u32,
+    receiver: u32,
+    config: &VisibilityConfig,
+    mut clear: impl FnMut(DVec3, DVec3, u32, u32) -> bool,
+) -> f64 {
     let n = config.rays.max(1) as usize;
     let mut rng = Rng::for_link(config.seed, source, receiver);
     let k = (n as f64).sqrt().ceil() as usize;

@@ -182,7 +182,11 @@ pub fn parse_graph(text: &str, path: &Path) -> Result<Graph, GraphFileError> {
 
 fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFileError> {
     let file: FileGraph = toml::from_str(text).map_err(|e| GraphFileError {
-        errors: vec![Located { path: path.to_owned(), line: e.span().map(|s| line_of(text, s.start)), message: e.message().trim().to_owned() }],
+        errors: vec![Located {
+            path: path.to_owned(),
+            line: e.span().map(|s| line_of(text, s.start)),
+            message: e.message().trim().to_owned(),
+        }],
     })?;
     let mut errors = Vec::new();
     let at = |span: std::ops::Range<usize>| line_of(text, span.start);
@@ -195,7 +199,11 @@ fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFile
             "f64" => ParamType::F64,
             "u32" => ParamType::U32,
             other => {
-                errors.push(Located { path: path.to_owned(), line: Some(line), message: format!("unsupported parameter type `{other}` (expected `f64` or `u32`)") });
+                errors.push(Located {
+                    path: path.to_owned(),
+                    line: Some(line),
+                    message: format!("unsupported parameter type `{other}` (expected `f64` or `u32`)"),
+                });
                 continue;
             }
         };
@@ -209,7 +217,11 @@ fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFile
                 ParamValue::Fixed { default, min: fp.min.unwrap_or(lo), max: fp.max.unwrap_or(hi) }
             }
             _ => {
-                errors.push(Located { path: path.to_owned(), line: Some(line), message: format!("parameter `{}` needs exactly one of `default`, `computed`", fp.name) });
+                errors.push(Located {
+                    path: path.to_owned(),
+                    line: Some(line),
+                    message: format!("parameter `{}` needs exactly one of `default`, `computed`", fp.name),
+                });
                 continue;
             }
         };
@@ -231,7 +243,11 @@ fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFile
         for arm in &n.arms {
             let answers: Vec<Cow<'static, str>> = arm.on.get_ref().split('|').map(|a| Cow::Owned(a.trim().to_owned())).collect();
             if answers.iter().any(|a| a.is_empty()) {
-                errors.push(Located { path: path.to_owned(), line: Some(at(arm.on.span())), message: format!("empty answer in `{}`", arm.on.get_ref()) });
+                errors.push(Located {
+                    path: path.to_owned(),
+                    line: Some(at(arm.on.span())),
+                    message: format!("empty answer in `{}`", arm.on.get_ref()),
+                });
             }
             arms.push(Arm { answers: Cow::Owned(answers), target: Target::parse(arm.to.get_ref().trim()) });
             on.push(at(arm.on.span()));
@@ -261,7 +277,9 @@ fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFile
     }
     let mut parsed = Parsed {
         graph: Graph {
-            name: Cow::Owned(file.name.clone().unwrap_or_else(|| path.file_stem().map_or("graph".to_owned(), |s| s.to_string_lossy().into_owned()))),
+            name: Cow::Owned(
+                file.name.clone().unwrap_or_else(|| path.file_stem().map_or("graph".to_owned(), |s| s.to_string_lossy().into_owned())),
+            ),
             doc: Cow::Owned(file.doc.clone().unwrap_or_default()),
             params: Cow::Owned(params),
             start: file.start.as_ref().map_or(Target::parse("stop"), |s| Target::parse(s.get_ref().trim())),

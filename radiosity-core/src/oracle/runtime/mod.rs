@@ -81,7 +81,12 @@ impl DagOracle<NoProbe> {
 
 impl<P: Probe> DagOracle<P> {
     /// As [`DagOracle::new`], with functions for the computed parameters and a probe.
-    pub fn with_probe(graph: Graph, params: &[(String, f64)], computed: Vec<(String, ComputedParam)>, probe: P) -> Result<DagOracle<P>, RuntimeError> {
+    pub fn with_probe(
+        graph: Graph,
+        params: &[(String, f64)],
+        computed: Vec<(String, ComputedParam)>,
+        probe: P,
+    ) -> Result<DagOracle<P>, RuntimeError> {
         let checked = validate(&graph, &oracle_graph::validate::builtin_only).map_err(RuntimeError::Invalid)?;
         let mut values: Vec<f64> = graph
             .params

@@ -95,8 +95,9 @@ pub(super) fn triangulate(pts: &[DVec3]) -> Option<Vec<[usize; 3]>> {
                 return false;
             }
             let touches_corner = |q: usize| same(q, a) || same(q, b) || same(q, c);
-            let inside =
-                ring.iter().any(|&q| !touches_corner(q) && orient(a, b, q) >= -sliver && orient(b, c, q) >= -sliver && orient(c, a, q) >= -sliver);
+            let inside = ring
+                .iter()
+                .any(|&q| !touches_corner(q) && orient(a, b, q) >= -sliver && orient(b, c, q) >= -sliver && orient(c, a, q) >= -sliver);
             let crossing = (0..m).any(|e| {
                 let (s, t) = (ring[e], ring[(e + 1) % m]);
                 let touches_diagonal = same(s, a) || same(s, c) || same(t, a) || same(t, c);

@@ -433,7 +433,9 @@ impl Reader {
         match &*w[0] {
             "cxy" => {
                 let [x, y] = self.floats::<2>(e)?;
-                Chroma::new(x, y).map(Ok).ok_or_else(|| self.parse_err(line, format!("chromaticity ({x}, {y}) outside x, y >= 0, x + y <= 1")))
+                Chroma::new(x, y)
+                    .map(Ok)
+                    .ok_or_else(|| self.parse_err(line, format!("chromaticity ({x}, {y}) outside x, y >= 0, x + y <= 1")))
             }
             "cspec" => {
                 if w.len() < 5 {
@@ -450,9 +452,9 @@ impl Reader {
             }
             "cct" => {
                 let [kelvin] = self.floats::<1>(e)?;
-                color::from_temperature(kelvin)
-                    .map(Ok)
-                    .ok_or_else(|| self.parse_err(line, format!("colour temperature {kelvin} K is below {} K", color::MIN_COLOR_TEMPERATURE)))
+                color::from_temperature(kelvin).map(Ok).ok_or_else(|| {
+                    self.parse_err(line, format!("colour temperature {kelvin} K is below {} K", color::MIN_COLOR_TEMPERATURE))
+                })
             }
             _ => {
                 // `cmix w1 c1 w2 c2 ...`
@@ -462,10 +464,13 @@ impl Reader {
                 let mut parts = Vec::with_capacity(w.len() / 2);
                 for pair in w[1..].chunks(2) {
                     let weight = self.float(&pair[0], line)?;
-                    let c = self.colors.named.get(&pair[1]).ok_or_else(|| self.parse_err(line, format!("undefined colour `{}`", pair[1])))?;
+                    let c =
+                        self.colors.named.get(&pair[1]).ok_or_else(|| self.parse_err(line, format!("undefined colour `{}`", pair[1])))?;
                     parts.push((weight, c.clone().map_err(|why| self.parse_err(line, format!("colour `{}`: {why}", pair[1])))?));
                 }
-                color::mix(&parts).map(Ok).ok_or_else(|| self.parse_err(line, "`cmix` weights must sum to a positive value (and colours need y > 0)"))
+                color::mix(&parts)
+                    .map(Ok)
+                    .ok_or_else(|| self.parse_err(line, "`cmix` weights must sum to a positive value (and colours need y > 0)"))
             }
         }
     }
@@ -543,7 +548,8 @@ impl Reader {
         if let Some(id) = self.group_id {
             return id;
         }
-        let id = if self.objects.is_empty() { self.builder.group(ROOT_GROUP) } else { self.builder.group(&self.objects.join(GROUP_SEPARATOR)) };
+        let id =
+            if self.objects.is_empty() { self.builder.group(ROOT_GROUP) } else { self.builder.group(&self.objects.join(GROUP_SEPARATOR)) };
         self.group_id = Some(id);
         id
     }

@@ -138,7 +138,8 @@ fn primitive_counts_at_four_divisions() {
     let outward = |s: &Scene| s.polygons.iter().all(|p| p.poly.normal().dot(p.poly.centroid()) > 0.0);
     assert!(outward(&s));
     assert!(check(&format!("{vertices}sph c -1\n")).polygons.iter().all(|p| p.poly.normal().dot(p.poly.centroid()) < 0.0));
-    let fine = load_str(&format!("{vertices}sph c 1\n"), Path::new("t.mgf"), &MgfOptions { quarter_circle_divisions: 2, ..MgfOptions::default() });
+    let fine =
+        load_str(&format!("{vertices}sph c 1\n"), Path::new("t.mgf"), &MgfOptions { quarter_circle_divisions: 2, ..MgfOptions::default() });
     assert_eq!(fine.unwrap().polygons.len(), 32);
 }
 
@@ -244,7 +245,9 @@ fn unclosed_transform_in_an_include_stays_local() {
 
 #[test]
 fn spectra_and_temperatures() {
-    let s = check(&format!("{SQUARE}c flat =\n cspec 380 780 1 1 1 1\nc warm =\n cct 2856\nm w =\n c flat\n rd .5\n c warm\n ed 10\nf a b c d\n"));
+    let s = check(&format!(
+        "{SQUARE}c flat =\n cspec 380 780 1 1 1 1\nc warm =\n cct 2856\nm w =\n c flat\n rd .5\n c warm\n ed 10\nf a b c d\n"
+    ));
     let m = &s.materials[0];
     assert!(m.reflectance.iter().all(|r| (r - 0.5).abs() < 0.01), "{m:?}");
     assert!(m.emission[0] > m.emission[1] && m.emission[1] > m.emission[2], "incandescent is reddish: {m:?}");

@@ -171,7 +171,10 @@ mod tests {
         assert!(near(m.transform_point3(DVec3::ZERO), DVec3::new(1.0, 6.0, 0.0)));
         let m = spec("-i 1000003 -t 1 0 0 -rz 90").unwrap().matrix(&[]);
         // cos 90° is 6e-17, not 0: the error grows with the count.
-        assert!((m.transform_point3(DVec3::ZERO) - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-6, "the map has period 4 and 1000003 = 3 mod 4: {m:?}");
+        assert!(
+            (m.transform_point3(DVec3::ZERO) - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-6,
+            "the map has period 4 and 1000003 = 3 mod 4: {m:?}"
+        );
         let s = spec("-t -21 0 0 -a 15 -t 3 0 0").unwrap();
         assert_eq!(s.array_sizes, vec![15]);
         assert!(near(s.matrix(&[0]).transform_point3(DVec3::ZERO), DVec3::new(-21.0, 0.0, 0.0)));

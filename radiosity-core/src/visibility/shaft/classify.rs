@@ -70,7 +70,13 @@ pub fn element_vertices(h: &Hierarchy, id: ElementId) -> Vec<DVec3> {
 /// every segment between the two elements; visible only when no candidate reaches deeper than
 /// [`GRAZE_REL_TOL`] into the shaft.
 #[must_use]
-pub fn classify(objects: &ShaftObjects, h: &Hierarchy, emitter: ElementId, receiver: ElementId, parent_candidates: Option<&[u32]>) -> ShaftVerdict {
+pub fn classify(
+    objects: &ShaftObjects,
+    h: &Hierarchy,
+    emitter: ElementId,
+    receiver: ElementId,
+    parent_candidates: Option<&[u32]>,
+) -> ShaftVerdict {
     let shaft = shaft_of(h, emitter, receiver);
     let mut candidates = objects.candidates(&shaft, parent_candidates);
     // Polygons that are the link's own surfaces (kept by every descendant link of a surface).
@@ -82,7 +88,11 @@ pub fn classify(objects: &ShaftObjects, h: &Hierarchy, emitter: ElementId, recei
         let polys = objects.polygons_of(id);
         if polys.iter().any(|&p| is_own(p)) {
             // The object's bounding volume holds a link surface: judge its other polygons one by one.
-            let reach = polys.iter().filter(|&&p| !is_own(p)).map(|&p| depth_into(&shaft, objects.polys[p as usize].vertices())).fold(f64::NEG_INFINITY, f64::max);
+            let reach = polys
+                .iter()
+                .filter(|&&p| !is_own(p))
+                .map(|&p| depth_into(&shaft, objects.polys[p as usize].vertices()))
+                .fold(f64::NEG_INFINITY, f64::max);
             if reach >= -shaft.tol {
                 if reach > graze {
                     blocking.push(id);
@@ -154,4 +164,3 @@ fn reaches_deeper(objects: &ShaftObjects, shaft: &Shaft, id: u32, graze: f64) ->
         },
     }
 }
-

@@ -3,8 +3,8 @@
 //! against its parent's candidates.
 
 use super::build::Shaft;
-use super::objects::{BoundingVolume, ShaftObjects};
 use super::obb::Obb;
+use super::objects::{BoundingVolume, ShaftObjects};
 use crate::geom::Aabb;
 
 /// Conservative shaft against oriented box: false only when the box lies entirely outside one of
@@ -86,7 +86,8 @@ mod tests {
         // A thin plank along the anti-diagonal, beside the shaft near its corner; its world box
         // reaches into the shaft, the plank itself does not.
         let rot = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_4);
-        let obb = Obb { center: DVec3::new(8.0, 3.0, 0.5), axes: [rot * DVec3::X, rot * DVec3::Y, DVec3::Z], half: DVec3::new(3.0, 0.05, 0.5) };
+        let obb =
+            Obb { center: DVec3::new(8.0, 3.0, 0.5), axes: [rot * DVec3::X, rot * DVec3::Y, DVec3::Z], half: DVec3::new(3.0, 0.05, 0.5) };
         assert!(may_intersect_aabb(&s, &obb.aabb()));
         assert!(!may_intersect_obb(&s, &obb));
         let inside = Obb { center: DVec3::new(5.5, 5.5, 0.5), ..obb };

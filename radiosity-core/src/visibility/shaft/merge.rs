@@ -120,7 +120,9 @@ mod tests {
         assert_eq!(m[0].vertices.len(), 4);
         assert_eq!(m[0].polygons, vec![0, 1]);
         // Three unit squares in an L: the first two merge into a 2 × 1 rectangle, the third cannot join.
-        let sq = |x: f64, y: f64| Poly::quad(DVec3::new(x, y, 0.0), DVec3::new(x + 1.0, y, 0.0), DVec3::new(x + 1.0, y + 1.0, 0.0), DVec3::new(x, y + 1.0, 0.0));
+        let sq = |x: f64, y: f64| {
+            Poly::quad(DVec3::new(x, y, 0.0), DVec3::new(x + 1.0, y, 0.0), DVec3::new(x + 1.0, y + 1.0, 0.0), DVec3::new(x, y + 1.0, 0.0))
+        };
         let polys = [sq(0.0, 0.0), sq(1.0, 0.0), sq(0.0, 1.0)];
         let m = merge_coplanar(&polys, &[0, 1, 2], 3.0);
         assert_eq!(m.len(), 1);
@@ -134,7 +136,8 @@ mod tests {
     #[test]
     fn split_floor_blocks_only_when_merged() {
         use crate::visibility::shaft::{convex_polygon_occludes, plate_occludes};
-        let quad_at = |z: f64, lo: f64, hi: f64| [DVec3::new(lo, lo, z), DVec3::new(hi, lo, z), DVec3::new(hi, hi, z), DVec3::new(lo, hi, z)];
+        let quad_at =
+            |z: f64, lo: f64, hi: f64| [DVec3::new(lo, lo, z), DVec3::new(hi, lo, z), DVec3::new(hi, hi, z), DVec3::new(lo, hi, z)];
         let (below, above) = (quad_at(-1.0, 0.2, 0.8), quad_at(1.0, 0.2, 0.8));
         let (a, b, c, d) = (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(2.0, -1.0, 0.0), DVec3::new(2.0, 2.0, 0.0), DVec3::new(-1.0, 2.0, 0.0));
         let polys = [Poly::triangle(a, b, c), Poly::triangle(a, c, d)];

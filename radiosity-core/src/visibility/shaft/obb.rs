@@ -85,11 +85,7 @@ impl Obb {
     /// The world box of the corners.
     #[must_use]
     pub fn aabb(&self) -> Aabb {
-        let r = DVec3::new(
-            self.radius_along(DVec3::X),
-            self.radius_along(DVec3::Y),
-            self.radius_along(DVec3::Z),
-        );
+        let r = DVec3::new(self.radius_along(DVec3::X), self.radius_along(DVec3::Y), self.radius_along(DVec3::Z));
         Aabb { min: self.center - r, max: self.center + r }
     }
 

@@ -168,7 +168,15 @@ impl ShaftObjects {
             self.merged.extend(merge_coplanar(&self.polys, members, aabb.diagonal()));
         }
         let merged_range = (merged_start, self.merged.len() as u32);
-        self.objects.push(ShaftObject { group, aabb, obb, poly_range: (start, self.object_polygons.len() as u32), hull_range, merged_range, solid });
+        self.objects.push(ShaftObject {
+            group,
+            aabb,
+            obb,
+            poly_range: (start, self.object_polygons.len() as u32),
+            hull_range,
+            merged_range,
+            solid,
+        });
     }
 
     /// Number of objects.

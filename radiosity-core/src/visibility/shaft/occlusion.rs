@@ -246,7 +246,8 @@ mod tests {
         let ceiling = quad_z(0.0, 0.0, 1.0, 1.0, 3.0);
         let slab = box_solid(DVec3::new(-1.0, -1.0, 1.0), DVec3::new(2.0, 2.0, 1.2));
         assert!(solid_occludes(&floor, &ceiling, &slab));
-        let plate = Poly::quad(DVec3::new(-1.0, -1.0, 1.5), DVec3::new(2.0, -1.0, 1.5), DVec3::new(2.0, 2.0, 1.5), DVec3::new(-1.0, 2.0, 1.5));
+        let plate =
+            Poly::quad(DVec3::new(-1.0, -1.0, 1.5), DVec3::new(2.0, -1.0, 1.5), DVec3::new(2.0, 2.0, 1.5), DVec3::new(-1.0, 2.0, 1.5));
         assert!(plate_occludes(&floor, &ceiling, &plate));
         // A slab that leaves a gap at one side does not.
         let short = box_solid(DVec3::new(-1.0, -1.0, 1.0), DVec3::new(0.9, 2.0, 1.2));
@@ -286,7 +287,8 @@ mod tests {
     fn touching_plate_does_not_occlude() {
         let a = quad_z(0.0, 0.0, 1.0, 1.0, 0.0);
         let b = quad_z(0.0, 0.0, 1.0, 1.0, 2.0);
-        let touching = Poly::quad(DVec3::new(-1.0, -1.0, 0.0), DVec3::new(2.0, -1.0, 0.0), DVec3::new(2.0, 2.0, 0.0), DVec3::new(-1.0, 2.0, 0.0));
+        let touching =
+            Poly::quad(DVec3::new(-1.0, -1.0, 0.0), DVec3::new(2.0, -1.0, 0.0), DVec3::new(2.0, 2.0, 0.0), DVec3::new(-1.0, 2.0, 0.0));
         assert!(!plate_occludes(&a, &b, &touching));
     }
 }

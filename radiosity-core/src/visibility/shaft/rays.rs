@@ -169,7 +169,12 @@ mod tests {
         assert!(segment_meets_box(DVec3::new(0.5, 0.5, 1.0), d.recip(), &Aabb::from_points(q.vertices())));
         // The prepared test agrees with the plain one.
         let p = PreparedPolygon::new(&q, 0).unwrap();
-        for (a, b) in [((0.5, 0.5, 1.0), (0.5, 0.5, -1.0)), ((1.5, 0.5, 1.0), (1.5, 0.5, -1.0)), ((0.5, 0.5, 2.0), (0.5, 0.5, 0.0)), ((0.0, 0.0, 1.0), (1.0, 1.0, -1.0))] {
+        for (a, b) in [
+            ((0.5, 0.5, 1.0), (0.5, 0.5, -1.0)),
+            ((1.5, 0.5, 1.0), (1.5, 0.5, -1.0)),
+            ((0.5, 0.5, 2.0), (0.5, 0.5, 0.0)),
+            ((0.0, 0.0, 1.0), (1.0, 1.0, -1.0)),
+        ] {
             let (a, b) = (DVec3::from(a), DVec3::from(b));
             assert_eq!(p.hit_by(a, b), segment_hits_polygon(a, b - a, &q), "{a} -> {b}");
         }
