@@ -64,19 +64,16 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         "rays": args.options.common.rays,
         "seed": args.options.common.seed,
         "min_area": args.options.common.min_area,
-        "visibility": !args.options.common.no_visibility,
+        "visibility": if args.options.common.no_visibility { "none" } else { args.options.common.visibility.as_str() },
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     let out_config =
         OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
-    // Write once to measure the output time, then rewrite stats.json with the final figures.
-    output::write_all(&args.out, &scene, &solved, &stats, &out_config)?;
+    output::write_solution(&args.out, &scene, &solved, &out_config)?;
     stats.time_s.output = t_out.elapsed().as_secs_f64();
     stats.time_s.total = t0.elapsed().as_secs_f64();
     stats.peak_rss_bytes = output::peak_rss_bytes();
-    let path = args.out.join("stats.json");
-    let json = serde_json::to_string_pretty(&stats).context("serialising stats")?;
-    std::fs::write(&path, json + "\n").with_context(|| format!("{}: cannot write", path.display()))?;
+    output::write_stats(&args.out, &stats)?;
     reporter.finish();
     if !args.quiet {
         print_summary(&stats, &args.out);

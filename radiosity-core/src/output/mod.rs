@@ -13,4 +13,4 @@ pub use ply::write_ply;
 pub use render::{RenderConfig, ToneMap, render, write_png};
 pub use smooth::CornerValues;
 pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};
-pub use write::{OutputConfig, OutputError, write_all};
+pub use write::{OutputConfig, OutputError, write_solution, write_stats};

@@ -35,9 +35,9 @@ fn create(path: &Path) -> Result<BufWriter<std::fs::File>, OutputError> {
     std::fs::File::create(path).map(BufWriter::new).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
 }
 
-/// Writes `patches.csv`, `solution.ply`, `image.png` (unless disabled) and `stats.json` into `dir`
-/// (created if needed). `stats` is written as given, after the other files.
-pub fn write_all(dir: &Path, scene: &Scene, solved: &Solved, stats: &Stats, config: &OutputConfig) -> Result<(), OutputError> {
+/// Writes `patches.csv`, `solution.ply` and `image.png` (unless disabled) into `dir` (created if
+/// needed); `stats.json` is written by [`write_stats`] once the output time is known.
+pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &OutputConfig) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|e| OutputError { path: dir.to_path_buf(), reason: e.to_string() })?;
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -62,6 +62,15 @@ pub fn write_all(dir: &Path, scene: &Scene, solved: &Solved, stats: &Stats, conf
             .map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
     }
 
+    Ok(())
+}
+
+/// Writes `stats.json` into `dir`.
+pub fn write_stats(dir: &Path, stats: &Stats) -> Result<(), OutputError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |e: std::io::Error| OutputError { path, reason: e.to_string() }
+    };
     let path = dir.join("stats.json");
     let mut w = create(&path)?;
     serde_json::to_writer_pretty(&mut w, stats).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
