@@ -34,6 +34,9 @@ pub struct Config {
     pub final_gather: bool,
     /// Budget of the leaf-resolution operator (coefficients, 12 bytes each).
     pub leaf_operator_max_entries: usize,
+    /// Estimate the solution's error after the solve ([`Solved::error_estimate`]); costs a
+    /// full-resolution gather at sampled leaves, which dominates small solves.
+    pub estimate_error: bool,
 }
 
 impl Default for Config {
@@ -48,6 +51,7 @@ impl Default for Config {
             visibility_method: VisibilityMethod::Rays,
             final_gather: true,
             leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
+            estimate_error: true,
         }
     }
 }
@@ -128,7 +132,8 @@ pub struct Solved {
     /// Machinery left out for this scene, in words.
     pub left_out: Vec<String>,
     /// A-posteriori error estimate, relative to the largest leaf radiosity: the one-step residual
-    /// against a full-resolution gather at sampled leaves (see [`solve::error_estimate`]).
+    /// against a full-resolution gather at sampled leaves (see [`solve::error_estimate`]); `None`
+    /// when [`Config::estimate_error`] is off.
     pub error_estimate: Option<f64>,
     /// Operator applications summed over passes.
     pub iterations: usize,
@@ -221,7 +226,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         }
         timings.solve += t.elapsed().as_secs_f64();
     }
-    let error_estimate = Some(solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
+    let error_estimate = config.estimate_error.then(|| solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
     Solved {

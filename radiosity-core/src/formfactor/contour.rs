@@ -5,8 +5,8 @@
 //! over the edges `a_i → a_i + e_i` of P1 and `b_j → b_j + e_j` of P2, both wound counter-clockwise
 //! about their front normals, fronts facing each other. Parallel edge pairs (including the collinear
 //! pair of a shared edge, where `ln r` is singular) are integrated in closed form; other pairs
-//! integrate the inner integral exactly and the outer one by adaptive Gauss–Legendre, which handles
-//! the logarithmic end singularity of edges sharing a vertex. Formulas as in the project's
+//! integrate the inner integral exactly and the outer one by adaptive Gauss–Legendre, graded toward
+//! the logarithmic singularity where the edges meet (a shared vertex, or a touching line). Formulas as in the project's
 //! `reference/formfactors.md` (e).
 //!
 //! It gives the *unoccluded* form factor of polygons that lie wholly in front of each other. For
@@ -21,6 +21,8 @@ use std::f64::consts::PI;
 pub const PARALLEL_SIN_TOL: f64 = 1e-9;
 /// Relative tolerance of the adaptive outer integral.
 pub const OUTER_REL_TOL: f64 = 1e-9;
+/// Edges shorter than this (in the normalised frame, where the pair spans 1) are dropped.
+pub const MIN_EDGE: f64 = 1e-12;
 /// Deepest bisection of the outer integral.
 pub const OUTER_MAX_DEPTH: u32 = 20;
 
@@ -64,8 +66,10 @@ fn polygon_area(p: &[DVec3]) -> f64 {
 fn edge_pair(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3) -> f64 {
     let dot = ea.dot(eb);
     let (la, lb) = (ea.length(), eb.length());
-    if la == 0.0 || lb == 0.0 || dot.abs() <= 1e-15 * la * lb {
-        return 0.0; // perpendicular (or empty) edges contribute nothing
+    if la <= MIN_EDGE || lb <= MIN_EDGE || dot.abs() <= 1e-15 * la * lb {
+        // Perpendicular edges contribute nothing; a vanishing edge contributes at most
+        // `ℓ·|ln r|`, and its integrand would be rounding noise.
+        return 0.0;
     }
     if ea.cross(eb).length() <= PARALLEL_SIN_TOL * la * lb {
         return parallel_pair(a, ea, b, eb);
@@ -133,24 +137,64 @@ const GL8: [(f64, f64); 8] = {
     ]
 };
 
-fn panel(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3, s0: f64, s1: f64) -> f64 {
-    let len = s1 - s0;
-    GL8.iter().map(|&(x, w)| w * inner(a + (s0 + x * len) * ea, b, eb)).sum::<f64>() * len
-}
+/// Distance (in the normalised frame, where the pair spans about 1) from edge `b` under which the
+/// outer integrand counts as (nearly) log-singular at the closest point of edge `a`, and the outer
+/// integral is graded toward that point.
+pub const GRADE_DISTANCE: f64 = 0.1;
+/// Power of the grading substitution `s = s* ± (…)·u^GRADE_POWER`: it turns the logarithmic
+/// singularity `ln|s − s*|` into `u^(p−1) ln u`, smooth enough for Gauss–Legendre panels.
+pub const GRADE_POWER: i32 = 3;
 
-/// `∫₀¹ inner(a + s e_a) ds` by adaptive bisection of Gauss–Legendre panels.
-fn outer_integral(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3) -> f64 {
-    fn rec(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3, s0: f64, s1: f64, whole: f64, depth: u32) -> f64 {
-        let m = 0.5 * (s0 + s1);
-        let (l, r) = (panel(a, ea, b, eb, s0, m), panel(a, ea, b, eb, m, s1));
+/// `∫₀¹ g(u) du` by adaptive bisection of 8-point Gauss–Legendre panels.
+fn adaptive(g: &dyn Fn(f64) -> f64) -> f64 {
+    fn panel(g: &dyn Fn(f64) -> f64, u0: f64, u1: f64) -> f64 {
+        let len = u1 - u0;
+        GL8.iter().map(|&(x, w)| w * g(u0 + x * len)).sum::<f64>() * len
+    }
+    fn rec(g: &dyn Fn(f64) -> f64, u0: f64, u1: f64, whole: f64, depth: u32) -> f64 {
+        let m = 0.5 * (u0 + u1);
+        let (l, r) = (panel(g, u0, m), panel(g, m, u1));
         let fine = l + r;
-        if depth == 0 || (fine - whole).abs() <= OUTER_REL_TOL * fine.abs().max(1e-3 * (s1 - s0)) {
+        if depth == 0 || (fine - whole).abs() <= OUTER_REL_TOL * fine.abs().max(1e-3 * (u1 - u0)) {
             return fine;
         }
-        rec(a, ea, b, eb, s0, m, l, depth - 1) + rec(a, ea, b, eb, m, s1, r, depth - 1)
+        rec(g, u0, m, l, depth - 1) + rec(g, m, u1, r, depth - 1)
     }
-    let whole = panel(a, ea, b, eb, 0.0, 1.0);
-    rec(a, ea, b, eb, 0.0, 1.0, whole, OUTER_MAX_DEPTH)
+    let whole = panel(g, 0.0, 1.0);
+    rec(g, 0.0, 1.0, whole, OUTER_MAX_DEPTH)
+}
+
+/// Parameter `s ∈ [0, 1]` of the point of segment `a + s·ea` closest to segment `b + t·eb`, and
+/// the distance there.
+fn closest_on_a(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3) -> (f64, f64) {
+    let r = a - b;
+    let (aa, bb, ab) = (ea.length_squared(), eb.length_squared(), ea.dot(eb));
+    let (ar, br) = (ea.dot(r), eb.dot(r));
+    let den = aa * bb - ab * ab;
+    let mut s = if den > 0.0 { ((ab * br - ar * bb) / den).clamp(0.0, 1.0) } else { 0.0 };
+    let t = ((ab * s + br) / bb).clamp(0.0, 1.0);
+    s = ((ab * t - ar) / aa).clamp(0.0, 1.0);
+    let t = ((ab * s + br) / bb).clamp(0.0, 1.0);
+    (s, (a + s * ea - b - t * eb).length())
+}
+
+/// `∫₀¹ inner(a + s e_a) ds`. Where edge `a` passes close to edge `b` (edges sharing a vertex, or
+/// meeting on the line where two polygons touch), the integrand is log-singular at the closest
+/// point `s*`; the integral is split there and each side graded toward it by `s = s* ± ℓ·u³`.
+fn outer_integral(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3) -> f64 {
+    let f = |s: f64| inner(a + s * ea, b, eb);
+    let (s_star, dist) = closest_on_a(a, ea, b, eb);
+    if dist > GRADE_DISTANCE * ea.length().max(eb.length()) {
+        return adaptive(&f);
+    }
+    let p = f64::from(GRADE_POWER);
+    let mut sum = 0.0;
+    for (len, sign) in [(s_star, -1.0), (1.0 - s_star, 1.0)] {
+        if len > 0.0 {
+            sum += adaptive(&|u: f64| f(s_star + sign * len * u.powi(GRADE_POWER)) * p * len * u.powi(GRADE_POWER - 1));
+        }
+    }
+    sum
 }
 
 #[cfg(test)]
@@ -225,5 +269,17 @@ mod tests {
         let sum: f64 = faces.iter().map(|f| polygon_polygon(&t1, f)).sum();
         // The other floor triangle is coplanar (F = 0).
         assert!((sum - 1.0).abs() < 1e-9, "{sum}");
+    }
+
+    #[test]
+    fn a_vanishing_edge_changes_nothing() {
+        // Clipping a polygon at a vertex lying on the plane repeats that vertex up to rounding; the
+        // edge of length ~1e-15 between the copies must neither change F nor stall the quadrature.
+        let p1 = [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)];
+        let p2 = [v(0., 0., 0.), v(0.3, 1., 0.), v(0.3, 1., 1.), v(0., 0., 1.)];
+        let mut p2_rep = p2.to_vec();
+        p2_rep.insert(1, v(1e-15, 3e-15, 0.));
+        let (f, g) = (polygon_polygon(&p1, &p2), polygon_polygon(&p1, &p2_rep));
+        assert!(f > 0.0 && (f - g).abs() < 1e-12, "{f} vs {g}");
     }
 }

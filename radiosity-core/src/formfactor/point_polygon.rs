@@ -4,7 +4,7 @@
 use crate::geom::DVec3;
 
 /// Largest number of vertices after clipping a quad by a plane (and a little room).
-const MAX_CLIPPED: usize = 8;
+pub const MAX_CLIPPED: usize = 8;
 
 /// Relative distance (to the polygon's size) under which a point counts as lying in the source's plane.
 pub const COPLANAR_REL_EPS: f64 = 1e-10;

@@ -478,7 +478,7 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, _a_eff: f64, eps: f64
         return [0.0; 3];
     }
     let oracle = BfHand { params: BfParams { eps } };
-    let solved = pipeline::run(&scene, &oracle, &pipeline::Config::default(), &|_| {});
+    let solved = pipeline::run(&scene, &oracle, &pipeline::Config { estimate_error: false, ..pipeline::Config::default() }, &|_| {});
     let h = &solved.hierarchy;
     let mut absorbed = [0.0; 3];
     for leaf in h.leaves() {

@@ -385,7 +385,7 @@ pub fn solve_instanced(
 
         // Solve, stream, keep only the proxies' irradiance.
         let t_local = std::time::Instant::now();
-        let solved = pipeline::run(&local, &oracle, &config.pipeline, &|_| {});
+        let solved = pipeline::run(&local, &oracle, &pipeline::Config { estimate_error: false, ..config.pipeline }, &|_| {});
         if config.trace {
             eprintln!(
                 "local solve {}: `{}` {} polygons ({} proxies), {} links, {:.3}s",
@@ -522,7 +522,9 @@ fn collect_leaves(h: &Hierarchy, e: ElementId, f: &mut dyn FnMut(ElementId)) {
 /// solve's link count.
 pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(PolygonMeans, u64), InstancingError> {
     let flat = super::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
-    let solved = pipeline::run(&flat, &BfHand { params: config.bf }, &config.pipeline, &|_| {});
+    // No error estimate: the comparison measures the error, and the instanced solve has none either.
+    let solved =
+        pipeline::run(&flat, &BfHand { params: config.bf }, &pipeline::Config { estimate_error: false, ..config.pipeline }, &|_| {});
     let mut means = PolygonMeans::default();
     let mut leaves = Vec::new();
     for i in 0..flat.polygons.len() {
