@@ -151,16 +151,33 @@ fn changing_a_prototype_invalidates_its_cache_entry() {
 }
 
 #[test]
-fn ply_stream_holds_every_streamed_leaf() {
+fn streamed_outputs_hold_every_polygon_and_leaf() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("cubes.ply");
     let scene = parse(&eight_cubes());
-    let mut ply = instancing::PlyStream::create(&path).unwrap();
-    let stats = solve_instanced(&scene, &config(), &mut ply).unwrap();
-    ply.finish().unwrap();
-    let text = std::fs::read_to_string(&path).unwrap();
-    let count = |key: &str| -> u64 { text.lines().find_map(|l| l.strip_prefix(key)).unwrap().trim().parse().unwrap() };
-    assert_eq!(count("element face "), stats.leaves_out);
-    let body = text.split("end_header\n").nth(1).unwrap();
-    assert_eq!(body.lines().count() as u64, count("element vertex ") + count("element face "));
+    let mut sink = instancing::StreamedOutput::create(dir.path(), &scene).unwrap();
+    let stats = solve_instanced(&scene, &config(), &mut sink).unwrap();
+    let render = radiosity_core::output::RenderConfig { width: 64, height: 48, samples: 2 };
+    let summary = sink.finish(&render).unwrap();
+    assert_eq!(summary.leaves, stats.leaves_out);
+    // PLY: the header's counts match the streamed leaves and the body's size.
+    let bytes = std::fs::read(dir.path().join("solution.ply")).unwrap();
+    let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    let count = |key: &str| -> u64 { header.lines().find_map(|l| l.strip_prefix(key)).unwrap().trim().parse().unwrap() };
+    let (n_vertices, n_faces) = (count("element vertex "), count("element face "));
+    assert_eq!(n_faces, stats.leaves_out);
+    // 27 bytes a vertex; a face is its count byte and 4-byte indices.
+    assert_eq!((bytes.len() - end) as u64, 27 * n_vertices + n_faces + 4 * n_vertices);
+    // patches.csv: a row per flattened polygon, every index once.
+    let csv = std::fs::read_to_string(dir.path().join("patches.csv")).unwrap();
+    let mut rows: Vec<u64> = csv.lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
+    assert_eq!(rows.len() as u64, stats.polygons_out);
+    rows.sort_unstable();
+    rows.dedup();
+    assert_eq!(rows.len() as u64, stats.polygons_out);
+    // The image shows something lit, and the spool is gone.
+    let img = image::open(dir.path().join("image.png")).unwrap().to_rgb8();
+    assert_eq!((img.width(), img.height()), (64, 48));
+    assert!(img.pixels().any(|p| p.0.iter().any(|&c| c > 0)), "image is black");
+    assert!(!dir.path().join("solution.spool").exists());
 }

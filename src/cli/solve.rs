@@ -120,34 +120,73 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
     println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());
 }
 
-/// An instanced scene (`.toml`): solved depth-first, one instance open at a time, polygons streamed
-/// to `solution.ply`; `stats.json` holds the instanced solver's figures.
+/// An instanced scene (`.toml`): solved depth-first, one instance open at a time, finished polygons
+/// streamed to `patches.csv` and a spool from which `solution.ply` and `image.png` are written at
+/// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
 fn solve_instanced(args: &SolveArgs) -> anyhow::Result<()> {
-    use radiosity::instancing::{self, InstancedConfig, PlyStream};
+    use radiosity::instancing::{self, InstancedConfig, StreamedOutput};
     let t0 = Instant::now();
     let path = args.scene.as_ref().expect("checked by the caller");
     let scene = instancing::load(path)?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
     let mut config = InstancedConfig { cache_dir: Some(args.out.join("prototype-cache")), ..InstancedConfig::default() };
     config.bf.eps = args.options.eps;
     config.pipeline = args.options.config();
-    let mut ply = PlyStream::create(&args.out.join("solution.ply"))?;
-    let stats = instancing::solve_instanced(&scene, &config, &mut ply)?;
-    ply.finish()?;
+    let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
+    let mut sink = Progressing { inner: StreamedOutput::create(&args.out, &scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
+    let stats = instancing::solve_instanced(&scene, &config, &mut sink)?;
+    sink.reporter.finish();
+    let sink = sink.inner;
+    let t_out = Instant::now();
+    let render = output::RenderConfig { width: args.size, height: args.size, ..Default::default() };
+    let written = sink.finish(&render)?;
+    if args.no_image {
+        let _ = std::fs::remove_file(args.out.join("image.png"));
+    }
     let mut doc = serde_json::to_value(&stats).context("serialising stats")?;
     doc["scene"] = serde_json::json!(path.display().to_string());
     doc["oracle"] = serde_json::json!("bf-hand");
-    doc["time_s"] = serde_json::json!({ "total": t0.elapsed().as_secs_f64() });
+    doc["eps"] = serde_json::json!(args.options.eps);
+    doc["tone_white"] = serde_json::json!(written.white);
+    doc["time_s"] =
+        serde_json::json!({ "solve": stats.seconds, "output": t_out.elapsed().as_secs_f64(), "total": t0.elapsed().as_secs_f64() });
     doc["peak_rss_bytes"] = serde_json::json!(output::peak_rss_bytes());
     let stats_path = args.out.join("stats.json");
     std::fs::write(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
         .with_context(|| format!("{}: cannot write", stats_path.display()))?;
     if !args.quiet {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
         println!(
-            "wrote {0}/solution.ply and {0}/stats.json (image.png and patches.csv are not written for instanced scenes yet)",
-            args.out.display()
+            "{} local solves, {} polygons, {} leaves, {} links; {:.1}s; peak RSS {}",
+            stats.local_solves,
+            stats.polygons_out,
+            stats.leaves_out,
+            stats.links,
+            t0.elapsed().as_secs_f64(),
+            output::peak_rss_bytes().map_or("n/a".to_string(), |b| format!("{:.1} MB", b as f64 / 1e6))
         );
+        let files = if args.no_image { "solution.ply,patches.csv,stats.json" } else { "image.png,solution.ply,patches.csv,stats.json" };
+        println!("wrote {}/{{{files}}}", args.out.display());
     }
     Ok(())
+}
+
+/// Shows the share of flattened polygons finished while passing them on.
+struct Progressing<S> {
+    inner: S,
+    done: u64,
+    total: u64,
+    reporter: Reporter,
+}
+
+impl<S: radiosity::instancing::RadiositySink> radiosity::instancing::RadiositySink for Progressing<S> {
+    fn polygon(
+        &mut self,
+        info: &radiosity::instancing::PolygonInfo,
+        leaves: &[radiosity::instancing::Leaf],
+    ) -> Result<(), radiosity::instancing::InstancingError> {
+        self.done += 1;
+        if self.done % 4096 == 0 {
+            self.reporter.phase(&format!("instanced solve: {} of {} polygons finished", self.done, self.total));
+        }
+        self.inner.polygon(info, leaves)
+    }
 }

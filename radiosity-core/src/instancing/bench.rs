@@ -53,7 +53,7 @@ pub fn bench_instanced(
 ) -> Result<(BenchRow, Option<PolygonMeans>), InstancingError> {
     struct Discard;
     impl super::solver::RadiositySink for Discard {
-        fn polygon(&mut self, _: u64, _: u32, _: &[(crate::geom::Poly, [f64; 3])]) -> Result<(), InstancingError> {
+        fn polygon(&mut self, _: &super::solver::PolygonInfo, _: &[super::solver::Leaf]) -> Result<(), InstancingError> {
             Ok(())
         }
     }

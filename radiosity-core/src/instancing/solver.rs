@@ -29,8 +29,7 @@ use crate::pipeline;
 use crate::refine::{BfHand, BfParams};
 use crate::scene::{Material, SceneBuilder, shapes::box_faces};
 use std::collections::HashMap;
-use std::io::{Seek, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Largest reflectance given to a proxy (the builder requires ρ < 1).
 pub const MAX_PROXY_REFLECTANCE: f64 = 0.99;
@@ -95,11 +94,32 @@ pub struct InstancedStats {
     pub seconds: f64,
 }
 
+/// A finished leaf element of a streamed polygon.
+#[derive(Clone, Copy, Debug)]
+pub struct Leaf {
+    /// The element's polygon (world coordinates).
+    pub poly: Poly,
+    /// Radiosity B (W/m², RGB).
+    pub b: [f64; 3],
+    /// Front-side irradiance H (W/m², RGB), light from outside an opened instance included.
+    pub h: [f64; 3],
+}
+
+/// Which flattened polygon a streamed polygon is.
+#[derive(Clone, Copy, Debug)]
+pub struct PolygonInfo {
+    /// Index in [`super::flatten`] order with two-sided pairs.
+    pub flat_index: u64,
+    /// Scene material.
+    pub material: u32,
+    /// Prototype that holds the polygon.
+    pub prototype: PrototypeId,
+}
+
 /// Receives finished polygons, in flattening order of each local problem (not globally sorted).
 pub trait RadiositySink {
-    /// Flattened polygon `flat_index` (its index in [`super::flatten`] with two-sided pairs), of
-    /// scene material `material`, finished: its leaf elements and their radiosity (W/m², RGB).
-    fn polygon(&mut self, flat_index: u64, material: u32, leaves: &[(Poly, [f64; 3])]) -> Result<(), InstancingError>;
+    /// Polygon `info` finished, with its leaf elements.
+    fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError>;
 }
 
 /// Keeps the area-weighted mean radiosity of every flattened polygon (memory linear in the
@@ -113,95 +133,22 @@ pub struct PolygonMeans {
 }
 
 impl RadiositySink for PolygonMeans {
-    fn polygon(&mut self, flat_index: u64, _material: u32, leaves: &[(Poly, [f64; 3])]) -> Result<(), InstancingError> {
-        let i = flat_index as usize;
+    fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError> {
+        let i = info.flat_index as usize;
         if self.radiosity.len() <= i {
             self.radiosity.resize(i + 1, [0.0; 3]);
             self.area.resize(i + 1, 0.0);
         }
         let (mut acc, mut area) = ([0.0; 3], 0.0);
-        for (p, b) in leaves {
-            let a = p.area();
+        for leaf in leaves {
+            let a = leaf.poly.area();
             for c in 0..3 {
-                acc[c] += a * b[c];
+                acc[c] += a * leaf.b[c];
             }
             area += a;
         }
         self.radiosity[i] = acc.map(|x| if area > 0.0 { x / area } else { 0.0 });
         self.area[i] = area;
-        Ok(())
-    }
-}
-
-/// Streams leaf elements to an ASCII PLY file (vertices with radiosity as `float r g b`), with
-/// constant memory: faces go to a side file that is appended when [`PlyStream::finish`] is called.
-pub struct PlyStream {
-    path: PathBuf,
-    file: std::io::BufWriter<std::fs::File>,
-    faces_path: PathBuf,
-    faces: std::io::BufWriter<std::fs::File>,
-    n_vertices: u64,
-    n_faces: u64,
-}
-
-/// Width of the vertex and face counts in the PLY header, patched in place at the end.
-const PLY_COUNT_WIDTH: usize = 12;
-
-impl PlyStream {
-    /// Creates `path` (and a `.faces` side file next to it).
-    pub fn create(path: &Path) -> Result<PlyStream, InstancingError> {
-        let io = |p: &Path, e| InstancingError::io(p, "cannot write file", e);
-        let mut file = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| io(path, e))?);
-        let faces_path = path.with_extension("ply.faces");
-        let faces = std::io::BufWriter::new(std::fs::File::create(&faces_path).map_err(|e| io(&faces_path, e))?);
-        write!(
-            file,
-            "ply\nformat ascii 1.0\nelement vertex {:0w$}\nproperty double x\nproperty double y\nproperty double z\nproperty float r\nproperty float g\nproperty float b\nelement face {:0w$}\nproperty list uchar int vertex_indices\nend_header\n",
-            0,
-            0,
-            w = PLY_COUNT_WIDTH
-        )
-        .map_err(|e| io(path, e))?;
-        Ok(PlyStream { path: path.to_owned(), file, faces_path, faces, n_vertices: 0, n_faces: 0 })
-    }
-
-    /// Appends the faces, patches the counts and removes the side file.
-    pub fn finish(self) -> Result<(), InstancingError> {
-        let PlyStream { path, file, faces_path, faces, n_vertices, n_faces } = self;
-        let io = |p: &Path, e| InstancingError::io(p, "cannot write file", e);
-        drop(faces.into_inner().map_err(|e| io(&faces_path, e.into_error()))?);
-        let mut file = file.into_inner().map_err(|e| io(&path, e.into_error()))?;
-        let mut side = std::fs::File::open(&faces_path).map_err(|e| io(&faces_path, e))?;
-        std::io::copy(&mut side, &mut file).map_err(|e| io(&path, e))?;
-        let header = format!("ply\nformat ascii 1.0\nelement vertex {:0w$}\n", n_vertices, w = PLY_COUNT_WIDTH);
-        file.seek(std::io::SeekFrom::Start(0)).map_err(|e| io(&path, e))?;
-        file.write_all(header.as_bytes()).map_err(|e| io(&path, e))?;
-        let offset = header.len()
-            + "property double x\nproperty double y\nproperty double z\nproperty float r\nproperty float g\nproperty float b\n".len();
-        file.seek(std::io::SeekFrom::Start(offset as u64)).map_err(|e| io(&path, e))?;
-        file.write_all(format!("element face {:0w$}\n", n_faces, w = PLY_COUNT_WIDTH).as_bytes()).map_err(|e| io(&path, e))?;
-        let _ = std::fs::remove_file(&faces_path);
-        Ok(())
-    }
-}
-
-impl RadiositySink for PlyStream {
-    fn polygon(&mut self, _flat_index: u64, _material: u32, leaves: &[(Poly, [f64; 3])]) -> Result<(), InstancingError> {
-        let io = |p: &Path, e| InstancingError::io(p, "cannot write file", e);
-        for (p, b) in leaves {
-            let vs = p.vertices();
-            for v in vs {
-                writeln!(self.file, "{} {} {} {} {} {}", v.x, v.y, v.z, b[0] as f32, b[1] as f32, b[2] as f32)
-                    .map_err(|e| io(&self.path, e))?;
-            }
-            write!(self.faces, "{}", vs.len()).map_err(|e| io(&self.faces_path, e))?;
-            for k in 0..vs.len() as u64 {
-                write!(self.faces, " {}", self.n_vertices + k).map_err(|e| io(&self.faces_path, e))?;
-            }
-            writeln!(self.faces).map_err(|e| io(&self.faces_path, e))?;
-            self.n_vertices += vs.len() as u64;
-            self.n_faces += 1;
-        }
         Ok(())
     }
 }
@@ -227,7 +174,7 @@ struct Task {
 /// What a polygon of a local problem stands for.
 #[derive(Clone, Copy)]
 enum Role {
-    Own { flat_index: u64, material: u32 },
+    Own(PolygonInfo),
     ProxyFace { slot: usize, face: usize },
 }
 
@@ -254,14 +201,14 @@ pub fn solve_instanced(
     while let Some(task) = stack.pop() {
         // Gather the level: own polygons of the task and of instances opened in place, and the
         // closed instances.
-        let mut own: Vec<(Poly, u32, u64)> = Vec::new();
+        let mut own: Vec<(Poly, u32, u64, PrototypeId)> = Vec::new();
         let mut closed: Vec<(PrototypeId, Transform, u64)> = Vec::new();
         let mut pending = vec![(task.prototype, task.transform, task.flat_base)];
         while let Some((pid, t, base)) = pending.pop() {
             let p = scene.prototype(pid);
             let mut k = base;
             for q in &p.polygons {
-                own.push((t.poly(&q.poly), q.material, k));
+                own.push((t.poly(&q.poly), q.material, k, pid));
                 k += 1;
                 if scene.materials[q.material as usize].two_sided {
                     k += 1;
@@ -321,10 +268,10 @@ pub fn solve_instanced(
             }
             Ok(())
         };
-        for &(poly, material, k) in &own {
-            add(&mut b, &mut roles, &poly, material, Role::Own { flat_index: k, material })?;
+        for &(poly, material, k, prototype) in &own {
+            add(&mut b, &mut roles, &poly, material, Role::Own(PolygonInfo { flat_index: k, material, prototype }))?;
             if scene.materials[material as usize].two_sided {
-                add(&mut b, &mut roles, &reversed(&poly), material, Role::Own { flat_index: k + 1, material })?;
+                add(&mut b, &mut roles, &reversed(&poly), material, Role::Own(PolygonInfo { flat_index: k + 1, material, prototype }))?;
             }
         }
         let mut proxy_material: HashMap<PrototypeId, u32> = HashMap::new();
@@ -405,16 +352,22 @@ pub fn solve_instanced(
         let mut leaves = Vec::new();
         for (i, role) in roles.iter().enumerate() {
             match *role {
-                Role::Own { flat_index, material } => {
+                Role::Own(info) => {
                     leaves.clear();
+                    let ext = external.get(i).copied().unwrap_or([0.0; 3]);
                     collect_leaves(h, i as ElementId, &mut |e| {
                         if let Some(p) = h.get(e).poly() {
-                            leaves.push((*p, solved.solution.radiosity[e as usize]));
+                            let irr = solved.solution.irradiance[e as usize];
+                            leaves.push(Leaf {
+                                poly: *p,
+                                b: solved.solution.radiosity[e as usize],
+                                h: std::array::from_fn(|c| irr[c] + ext[c]),
+                            });
                         }
                     });
                     stats.leaves_out += leaves.len() as u64;
                     stats.polygons_out += 1;
-                    sink.polygon(flat_index, material, &leaves)?;
+                    sink.polygon(&info, &leaves)?;
                 }
                 Role::ProxyFace { slot, face } => {
                     let (mut acc, mut area) = ([0.0; 3], 0.0);
@@ -531,10 +484,10 @@ pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(P
         leaves.clear();
         collect_leaves(&solved.hierarchy, i as ElementId, &mut |e| {
             if let Some(p) = solved.hierarchy.get(e).poly() {
-                leaves.push((*p, solved.solution.radiosity[e as usize]));
+                leaves.push(Leaf { poly: *p, b: solved.solution.radiosity[e as usize], h: solved.solution.irradiance[e as usize] });
             }
         });
-        means.polygon(i as u64, flat.polygons[i].material, &leaves)?;
+        means.polygon(&PolygonInfo { flat_index: i as u64, material: flat.polygons[i].material, prototype: scene.root }, &leaves)?;
     }
     Ok((means, solved.links.len() as u64))
 }

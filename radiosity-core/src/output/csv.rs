@@ -61,6 +61,8 @@ pub fn write_patches_csv(w: &mut impl Write, scene: &Scene, results: &[PolygonRe
     Ok(())
 }
 
-fn csv_field(s: &str) -> String {
+/// `s` as one CSV field (quoted when it holds a comma, quote or line break).
+#[must_use]
+pub fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_owned() }
 }

@@ -8,7 +8,7 @@ mod smooth;
 mod stats;
 mod write;
 
-pub use csv::{PolygonResult, polygon_results, write_patches_csv};
+pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
 pub use ply::write_ply;
 pub use render::{RenderConfig, ToneMap, render, write_png};
 pub use smooth::CornerValues;

@@ -1,0 +1,349 @@
+//! The outputs of an instanced solve (`solution.ply`, `patches.csv`, `image.png`), written in memory
+//! that does not grow with the scene: finished polygons are streamed, `patches.csv` row by row and
+//! the leaf elements to a spool file beside the outputs; [`StreamedOutput::finish`] then reads the
+//! spool back to write the PLY (whose header needs the counts, and whose colours need the tone map of
+//! the whole solution) and to draw the image with a z-buffer, and removes the spool.
+//!
+//! Differences from a plain solve's outputs: `patches.csv` rows come in solve order (the `index`
+//! column is the flattened polygon's index), their `group` is the prototype that holds the polygon;
+//! the PLY and the image are flat-shaded per leaf (no smoothing across leaves, which would need the
+//! neighbours in memory); the image is seen from the side (looking along +y, z up: the plant
+//! generator's convention), as instanced scene files carry no camera.
+
+use super::InstancingError;
+use super::model::InstancedScene;
+use super::solver::{Leaf, PolygonInfo, RadiositySink};
+use crate::geom::{Aabb, DVec3};
+use crate::output::{RenderConfig, ToneMap};
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+/// Bins per decade of the radiosity histogram that sets the tone map's white point.
+const TONE_BINS_PER_DECADE: f64 = 16.0;
+/// Smallest radiosity the histogram resolves (W/m²); smaller values fall in the first bin.
+const TONE_MIN: f64 = 1e-12;
+/// Number of histogram bins (24 decades).
+const TONE_BINS: usize = 24 * 16;
+
+/// Streams an instanced solve's outputs into a folder; see the module docs.
+pub struct StreamedOutput {
+    dir: PathBuf,
+    spool_path: PathBuf,
+    spool: BufWriter<std::fs::File>,
+    csv_path: PathBuf,
+    csv: BufWriter<std::fs::File>,
+    prototype_names: Vec<String>,
+    material_names: Vec<String>,
+    emitter: Vec<bool>,
+    bounds: Aabb,
+    leaves: u64,
+    vertices: u64,
+    histogram: Vec<u64>,
+    max_b: f64,
+}
+
+/// What [`StreamedOutput::finish`] wrote.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct StreamedSummary {
+    /// Leaf elements in `solution.ply`.
+    pub leaves: u64,
+    /// Radiosity shown as white in the PLY colours and the image (W/m²).
+    pub white: f64,
+}
+
+fn io_err(path: &Path, e: std::io::Error) -> InstancingError {
+    InstancingError::io(path, "cannot write file", e)
+}
+
+impl StreamedOutput {
+    /// Creates `dir` and opens `patches.csv` and the spool in it.
+    pub fn create(dir: &Path, scene: &InstancedScene) -> Result<StreamedOutput, InstancingError> {
+        std::fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
+        let open = |name: &str| -> Result<(PathBuf, BufWriter<std::fs::File>), InstancingError> {
+            let path = dir.join(name);
+            let file = std::fs::File::create(&path).map_err(|e| io_err(&path, e))?;
+            Ok((path, BufWriter::new(file)))
+        };
+        let (spool_path, spool) = open("solution.spool")?;
+        let (csv_path, mut csv) = open("patches.csv")?;
+        writeln!(csv, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b").map_err(|e| io_err(&csv_path, e))?;
+        Ok(StreamedOutput {
+            dir: dir.to_owned(),
+            spool_path,
+            spool,
+            csv_path,
+            csv,
+            prototype_names: scene.prototypes.iter().map(|p| p.name.clone()).collect(),
+            material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
+            emitter: scene.materials.iter().map(crate::scene::Material::is_emitter).collect(),
+            bounds: Aabb::EMPTY,
+            leaves: 0,
+            vertices: 0,
+            histogram: vec![0; TONE_BINS],
+            max_b: 0.0,
+        })
+    }
+
+    /// The tone map of the streamed solution: the rule of [`ToneMap::from_scene`] (white at 1.3 ×
+    /// the larger of the 95th percentile and 0.3 × the largest non-emitter polygon radiosity), with
+    /// the percentile read from a logarithmic histogram (bins 1/16 of a decade wide).
+    fn tone(&self) -> ToneMap {
+        let total: u64 = self.histogram.iter().sum();
+        if total == 0 {
+            return ToneMap { white: 1.0 };
+        }
+        let rank = (total as f64 * 0.95) as u64;
+        let (mut seen, mut bin) = (0, 0);
+        for (i, &n) in self.histogram.iter().enumerate() {
+            seen += n;
+            bin = i;
+            if seen > rank {
+                break;
+            }
+        }
+        let p95 = (TONE_MIN * 10f64.powf((bin as f64 + 1.0) / TONE_BINS_PER_DECADE)).min(self.max_b);
+        let white = p95.max(0.3 * self.max_b) * 1.3;
+        ToneMap { white: if white > 0.0 { white } else { 1.0 } }
+    }
+
+    /// Writes `solution.ply` and `image.png` from the spool, then removes it.
+    pub fn finish(mut self, render: &RenderConfig) -> Result<StreamedSummary, InstancingError> {
+        self.csv.flush().map_err(|e| io_err(&self.csv_path, e))?;
+        self.spool.flush().map_err(|e| io_err(&self.spool_path, e))?;
+        let tone = self.tone();
+        self.write_ply(&tone)?;
+        let rgb = self.render(&tone, render)?;
+        let png = self.dir.join("image.png");
+        crate::output::write_png(&png, &rgb, render.width, render.height)
+            .map_err(|e| InstancingError::io(&png, "cannot write image", std::io::Error::other(e)))?;
+        let _ = std::fs::remove_file(&self.spool_path);
+        Ok(StreamedSummary { leaves: self.leaves, white: tone.white })
+    }
+
+    /// Calls `f` on every spooled leaf: its vertices and radiosity.
+    fn read_spool(&self, f: &mut dyn FnMut(&[DVec3], [f64; 3])) -> Result<(), InstancingError> {
+        let path = &self.spool_path;
+        let file = std::fs::File::open(path).map_err(|e| InstancingError::io(path, "cannot read file", e))?;
+        let mut r = BufReader::new(file);
+        let mut rec = [0u8; 1 + 4 * 3 * 4 + 4 * 3];
+        let mut vs = [DVec3::ZERO; 4];
+        for _ in 0..self.leaves {
+            r.read_exact(&mut rec[..1]).map_err(|e| InstancingError::io(path, "cannot read file", e))?;
+            let n = usize::from(rec[0]).min(4);
+            let len = 1 + 12 * n + 12;
+            r.read_exact(&mut rec[1..len]).map_err(|e| InstancingError::io(path, "cannot read file", e))?;
+            let float = |k: usize| f64::from(f32::from_le_bytes(rec[1 + 4 * k..5 + 4 * k].try_into().expect("4 bytes")));
+            for (i, v) in vs.iter_mut().enumerate().take(n) {
+                *v = DVec3::new(float(3 * i), float(3 * i + 1), float(3 * i + 2));
+            }
+            f(&vs[..n], [float(3 * n), float(3 * n + 1), float(3 * n + 2)]);
+        }
+        Ok(())
+    }
+
+    /// Binary PLY with the properties of the plain solve's `solution.ply` (flat per leaf).
+    fn write_ply(&self, tone: &ToneMap) -> Result<(), InstancingError> {
+        let path = self.dir.join("solution.ply");
+        let file = std::fs::File::create(&path).map_err(|e| io_err(&path, e))?;
+        let mut w = BufWriter::new(file);
+        write!(
+            w,
+            "ply\nformat binary_little_endian 1.0\ncomment radiosity solution (instanced, flat per leaf), radiosity in W/m2\n\
+             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float radiosity_r\nproperty float radiosity_g\nproperty float radiosity_b\n\
+             property uchar red\nproperty uchar green\nproperty uchar blue\n\
+             element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+            self.vertices, self.leaves
+        )
+        .map_err(|e| io_err(&path, e))?;
+        let mut result = Ok(());
+        self.read_spool(&mut |vs, b| {
+            let px = tone.map(b);
+            for v in vs {
+                let mut rec = [0u8; 27];
+                for (k, x) in [v.x, v.y, v.z, b[0], b[1], b[2]].into_iter().enumerate() {
+                    rec[4 * k..4 * k + 4].copy_from_slice(&(x as f32).to_le_bytes());
+                }
+                rec[24..27].copy_from_slice(&px);
+                if result.is_ok() {
+                    result = w.write_all(&rec);
+                }
+            }
+        })?;
+        std::mem::replace(&mut result, Ok(())).map_err(|e| io_err(&path, e))?;
+        let mut next = 0i32;
+        self.read_spool(&mut |vs, _| {
+            let mut rec = [0u8; 17];
+            rec[0] = vs.len() as u8;
+            for k in 0..vs.len() {
+                rec[1 + 4 * k..5 + 4 * k].copy_from_slice(&(next + k as i32).to_le_bytes());
+            }
+            next += vs.len() as i32;
+            if result.is_ok() {
+                result = w.write_all(&rec[..1 + 4 * vs.len()]);
+            }
+        })?;
+        result.and_then(|()| w.flush()).map_err(|e| io_err(&path, e))
+    }
+
+    /// Draws the spooled leaves with a z-buffer at `samples`² supersampling; RGB bytes, rows from
+    /// the top.
+    fn render(&self, tone: &ToneMap, config: &RenderConfig) -> Result<Vec<u8>, InstancingError> {
+        let ss = config.samples.max(1) as usize;
+        let (w, h) = (config.width as usize * ss, config.height as usize * ss);
+        let mut depth = vec![0f32; w * h];
+        let mut color = vec![[0u8; 3]; w * h];
+        let b = if self.bounds.is_empty() { Aabb { min: DVec3::ZERO, max: DVec3::ONE } } else { self.bounds };
+        let cam = SideCamera::new(&b, config.width as f64 / config.height.max(1) as f64);
+        self.read_spool(&mut |vs, rad| {
+            let n = (vs[1] - vs[0]).cross(vs[vs.len() - 1] - vs[0]);
+            if n.dot(cam.eye - vs[0]) <= 0.0 {
+                return; // back side: the other side of a two-sided surface is its own polygon
+            }
+            let mut p = [[0.0f64; 3]; 4];
+            for (k, v) in vs.iter().enumerate() {
+                let Some(s) = cam.project(*v, w, h) else { return };
+                p[k] = s;
+            }
+            let px = tone.map(rad);
+            for k in 1..vs.len() - 1 {
+                fill_triangle([p[0], p[k], p[k + 1]], w, h, &mut |i, inv_z| {
+                    if inv_z > depth[i] {
+                        depth[i] = inv_z;
+                        color[i] = px;
+                    }
+                });
+            }
+        })?;
+        let mut out = Vec::with_capacity(3 * config.width as usize * config.height as usize);
+        for y in 0..config.height as usize {
+            for x in 0..config.width as usize {
+                let mut acc = [0u32; 3];
+                for sy in 0..ss {
+                    for sx in 0..ss {
+                        let c = color[(y * ss + sy) * w + x * ss + sx];
+                        for k in 0..3 {
+                            acc[k] += u32::from(c[k]);
+                        }
+                    }
+                }
+                for a in acc {
+                    out.push(((a as f64) / (ss * ss) as f64).round() as u8);
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+impl RadiositySink for StreamedOutput {
+    fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError> {
+        let (mut area, mut b, mut h) = (0.0, [0.0; 3], [0.0; 3]);
+        let mut rec = Vec::with_capacity(64);
+        for leaf in leaves {
+            let a = leaf.poly.area();
+            area += a;
+            for c in 0..3 {
+                b[c] += a * leaf.b[c];
+                h[c] += a * leaf.h[c];
+            }
+            let vs = leaf.poly.vertices();
+            rec.clear();
+            rec.push(vs.len() as u8);
+            for v in vs {
+                self.bounds.grow(*v);
+                for x in [v.x, v.y, v.z] {
+                    rec.extend_from_slice(&(x as f32).to_le_bytes());
+                }
+            }
+            for x in leaf.b {
+                rec.extend_from_slice(&(x as f32).to_le_bytes());
+            }
+            self.spool.write_all(&rec).map_err(|e| io_err(&self.spool_path, e))?;
+            self.leaves += 1;
+            self.vertices += vs.len() as u64;
+        }
+        if area > 0.0 {
+            b = b.map(|v| v / area);
+            h = h.map(|v| v / area);
+        }
+        let emitter = self.emitter.get(info.material as usize).copied().unwrap_or(false);
+        let lum = b[0].max(b[1]).max(b[2]);
+        if !emitter && lum.is_finite() && lum > 0.0 {
+            let bin = ((lum / TONE_MIN).log10() * TONE_BINS_PER_DECADE).floor().clamp(0.0, (TONE_BINS - 1) as f64) as usize;
+            self.histogram[bin] += 1;
+            self.max_b = self.max_b.max(lum);
+        }
+        let group = self.prototype_names.get(info.prototype as usize).map_or("", String::as_str);
+        let material = self.material_names.get(info.material as usize).map_or("", String::as_str);
+        writeln!(
+            self.csv,
+            "{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            info.flat_index,
+            crate::output::csv_field(group),
+            crate::output::csv_field(material),
+            area,
+            b[0],
+            b[1],
+            b[2],
+            h[0],
+            h[1],
+            h[2]
+        )
+        .map_err(|e| io_err(&self.csv_path, e))
+    }
+}
+
+/// A pinhole camera on the −y side of a box looking along +y, z up, 40° vertical field of view,
+/// far enough to see the whole box.
+struct SideCamera {
+    eye: DVec3,
+    half_w: f64,
+    half_h: f64,
+    near: f64,
+}
+
+impl SideCamera {
+    fn new(b: &Aabb, aspect: f64) -> SideCamera {
+        let (c, e) = (b.center(), b.extent());
+        let half_h = (20f64).to_radians().tan();
+        let half_w = half_h * aspect.max(1e-9);
+        let dist = (0.5 * e.z / half_h).max(0.5 * e.x / half_w).max(1e-300) + 0.5 * e.y;
+        SideCamera { eye: c - DVec3::Y * dist * 1.05, half_w, half_h, near: 1e-9 * dist }
+    }
+
+    /// Pixel coordinates (x right, y down) and `1/depth` of `v`, or `None` behind the camera.
+    fn project(&self, v: DVec3, w: usize, h: usize) -> Option<[f64; 3]> {
+        let d = v - self.eye;
+        let (x, y, z) = (d.x, d.z, d.y);
+        if z <= self.near {
+            return None;
+        }
+        Some([(x / (z * self.half_w) + 1.0) * 0.5 * w as f64, (1.0 - y / (z * self.half_h)) * 0.5 * h as f64, 1.0 / z])
+    }
+}
+
+/// Calls `f(pixel index, 1/depth)` for every pixel centre inside the screen-space triangle `p`
+/// (either winding), with `1/depth` interpolated linearly in screen space (perspective-correct).
+fn fill_triangle(p: [[f64; 3]; 3], w: usize, h: usize, f: &mut dyn FnMut(usize, f32)) {
+    let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+    if area.abs() < 1e-12 || !area.is_finite() {
+        return;
+    }
+    let x0 = p.iter().map(|q| q[0]).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
+    let x1 = (p.iter().map(|q| q[0]).fold(f64::NEG_INFINITY, f64::max).ceil().min(w as f64)).max(0.0) as usize;
+    let y0 = p.iter().map(|q| q[1]).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
+    let y1 = (p.iter().map(|q| q[1]).fold(f64::NEG_INFINITY, f64::max).ceil().min(h as f64)).max(0.0) as usize;
+    let edge = |a: [f64; 3], b: [f64; 3], x: f64, y: f64| (b[0] - a[0]) * (y - a[1]) - (x - a[0]) * (b[1] - a[1]);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+            let w0 = edge(p[1], p[2], cx, cy) / area;
+            let w1 = edge(p[2], p[0], cx, cy) / area;
+            let w2 = 1.0 - w0 - w1;
+            if w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0 {
+                f(y * w + x, (w0 * p[0][2] + w1 * p[1][2] + w2 * p[2][2]) as f32);
+            }
+        }
+    }
+}
