@@ -55,6 +55,11 @@ pub struct InstancedConfig {
     pub incoming_rays: u32,
     /// Print one line per local solve to standard error.
     pub trace: bool,
+    /// Linear solver of every local solve (and of [`solve_full`], for a like-for-like comparison):
+    /// a short GMRES restart bounds the Krylov basis, which is the largest allocation of a local
+    /// problem (one vector of all elements per iteration), and a relative residual of 1e-7 is far
+    /// below the method's approximation error.
+    pub local_solve: crate::solve::SolveConfig,
 }
 
 impl Default for InstancedConfig {
@@ -67,6 +72,7 @@ impl Default for InstancedConfig {
             max_closed_polygons: 20_000,
             incoming_rays: 64,
             trace: false,
+            local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
         }
     }
 }
@@ -332,7 +338,8 @@ pub fn solve_instanced(
 
         // Solve, stream, keep only the proxies' irradiance.
         let t_local = std::time::Instant::now();
-        let solved = pipeline::run(&local, &oracle, &pipeline::Config { estimate_error: false, ..config.pipeline }, &|_| {});
+        let local_config = pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline };
+        let solved = pipeline::run(&local, &oracle, &local_config, &|_| {});
         if config.trace {
             eprintln!(
                 "local solve {}: `{}` {} polygons ({} proxies), {} links, {:.3}s",
@@ -477,7 +484,7 @@ pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(P
     let flat = super::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
     // No error estimate: the comparison measures the error, and the instanced solve has none either.
     let solved =
-        pipeline::run(&flat, &BfHand { params: config.bf }, &pipeline::Config { estimate_error: false, ..config.pipeline }, &|_| {});
+        pipeline::run(&flat, &BfHand { params: config.bf }, &pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline }, &|_| {});
     let mut means = PolygonMeans::default();
     let mut leaves = Vec::new();
     for i in 0..flat.polygons.len() {
