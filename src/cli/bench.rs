@@ -48,15 +48,29 @@ pub struct InstancingBenchArgs {
     /// Tree seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Refinement threshold of both methods.
+    /// Refinement threshold of the main comparison; the full solve at this threshold is the
+    /// reference of every error printed.
     #[arg(long, default_value_t = 0.05)]
     pub eps: f64,
+    /// Coarser thresholds of the error-against-time curve (both methods), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.4,0.2,0.1")]
+    pub sweep: Vec<f64>,
+    /// Forests to solve with instances: target polygon counts (two-sided leaves counted twice, as
+    /// the solver sees them), comma-separated; `none` for no forest.
+    #[arg(long, value_delimiter = ',', default_value = "1200000")]
+    pub forests: Vec<String>,
+    /// Folder of `instancing_error_time.csv` and `instancing_error_time.svg`.
+    #[arg(long, default_value = "bench-instancing")]
+    pub out: std::path::PathBuf,
     /// Print one JSON document instead of the table.
     #[arg(long)]
     pub json: bool,
     /// Internal: run one method (`full` or `instanced`) and write its per-polygon means here.
     #[arg(long, hide = true, num_args = 2, value_names = ["METHOD", "FILE"])]
     pub child: Vec<String>,
+    /// Internal: solve a generated forest of this many trees with instances and print its row.
+    #[arg(long, hide = true)]
+    pub forest_child: Option<u32>,
 }
 
 /// Arguments of `bench oracle`.
@@ -385,20 +399,30 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
 fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     use radiosity::instancing::bench::{BenchRow, bench_full, bench_instanced, load_means, save_means};
     use radiosity::instancing::solver::relative_error;
-    use radiosity::instancing::{InstancedConfig, generate_tree};
+    use radiosity::instancing::{ForestParams, InstancedConfig, generate_forest, generate_tree};
     anyhow::ensure!((1..=200).contains(&args.age), "--age must be between 1 and 200");
     anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
+    let config = |eps: f64| {
+        let mut config = InstancedConfig::default();
+        config.bf.eps = eps;
+        config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
+        config
+    };
+    let forest = |trees: u32| generate_forest(&ForestParams { trees, seed: args.seed, ..ForestParams::default() });
+    if let Some(trees) = args.forest_child {
+        let scene = forest(trees);
+        let (row, _) = bench_instanced(&scene, &config(args.eps), false)?;
+        println!("{}", serde_json::to_string(&row)?);
+        return Ok(());
+    }
     if let [method, file] = args.child.as_slice() {
         let scene = generate_tree(args.age, args.seed);
-        let mut config = InstancedConfig::default();
-        config.bf.eps = args.eps;
-        config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
         let (row, means) = match method.as_str() {
             "full" => {
-                let (row, means) = bench_full(&scene, &config)?;
+                let (row, means) = bench_full(&scene, &config(args.eps))?;
                 (row, Some(means))
             }
-            "instanced" => bench_instanced(&scene, &config, true)?,
+            "instanced" => bench_instanced(&scene, &config(args.eps), true)?,
             other => anyhow::bail!("unknown method `{other}`"),
         };
         if let Some(m) = means {
@@ -407,64 +431,131 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string(&row)?);
         return Ok(());
     }
+    for &e in &args.sweep {
+        anyhow::ensure!(e.is_finite() && e >= args.eps, "--sweep thresholds must be finite and at least --eps ({}), got {e}", args.eps);
+    }
     let exe = std::env::current_exe().context("locating this executable")?;
     let dir = std::env::temp_dir();
-    let mut rows: Vec<BenchRow> = Vec::new();
-    let mut files = Vec::new();
-    for method in ["instanced", "full"] {
-        let file = dir.join(format!("radiosity-bench-instancing-{method}-{}.bin", std::process::id()));
+    let run_child = |extra: &[String]| -> anyhow::Result<BenchRow> {
         let o = Command::new(&exe)
-            .args([
-                "bench",
-                "instancing",
-                "--age",
-                &args.age.to_string(),
-                "--seed",
-                &args.seed.to_string(),
-                "--eps",
-                &args.eps.to_string(),
-                "--child",
-                method,
-            ])
-            .arg(&file)
+            .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string()])
+            .args(extra)
             .output()
             .with_context(|| format!("running {}", exe.display()))?;
-        anyhow::ensure!(o.status.success(), "{method} solve failed: {}", String::from_utf8_lossy(&o.stderr).trim());
+        anyhow::ensure!(o.status.success(), "child solve failed: {}", String::from_utf8_lossy(&o.stderr).trim());
         let text = String::from_utf8_lossy(&o.stdout);
-        rows.push(serde_json::from_str(text.lines().last().unwrap_or("")).with_context(|| format!("{method}: unreadable result"))?);
-        files.push(file);
+        serde_json::from_str(text.lines().last().unwrap_or("")).context("unreadable child result")
+    };
+    // Every threshold, finest first: both methods, each in its own process (peak RSS per process).
+    let mut thresholds = vec![args.eps];
+    thresholds.extend(args.sweep.iter().copied().filter(|&e| e != args.eps));
+    let mut points: Vec<(BenchRow, f64, f64)> = Vec::new();
+    let mut reference = None;
+    for (k, &eps) in thresholds.iter().enumerate() {
+        for method in ["full", "instanced"] {
+            if !args.json {
+                eprintln!("tree age {}: {method} solve at eps {eps} ...", args.age);
+            }
+            let file = dir.join(format!("radiosity-bench-instancing-{method}-{}.bin", std::process::id()));
+            let row = run_child(&["--eps".into(), eps.to_string(), "--child".into(), method.into(), file.display().to_string()])?;
+            let means = load_means(&file)?;
+            let _ = std::fs::remove_file(&file);
+            if k == 0 && method == "full" {
+                reference = Some(means);
+                points.push((row, 0.0, 0.0));
+                continue;
+            }
+            let (worst, mean) = relative_error(reference.as_ref().expect("the full solve at --eps runs first"), &means);
+            points.push((row, worst, mean));
+        }
     }
-    let (inst, full) = (load_means(&files[0])?, load_means(&files[1])?);
-    for f in &files {
-        let _ = std::fs::remove_file(f);
+    let mut forests: Vec<(u32, BenchRow)> = Vec::new();
+    for target in args.forests.iter().filter(|f| f.as_str() != "none") {
+        let target: f64 = target.parse().with_context(|| format!("--forests: `{target}` is not a polygon count"))?;
+        anyhow::ensure!(target >= 1.0 && target.is_finite(), "--forests: polygon counts must be positive");
+        // Trees needed: from the mean count of a few trees, then up until the target is reached.
+        let count = |trees: u32| {
+            let f = forest(trees);
+            f.flattened_counts(true).get(f.root as usize).copied().unwrap_or(0) as f64
+        };
+        let mut trees = ((target / (count(8) / 8.0).max(1.0)).ceil() as u32).max(1);
+        while count(trees) < target {
+            trees += 1;
+        }
+        if !args.json {
+            eprintln!("forest of {trees} trees ({} polygons): instanced solve ...", count(trees));
+        }
+        forests.push((trees, run_child(&["--eps".into(), args.eps.to_string(), "--forest-child".into(), trees.to_string()])?));
     }
-    let (worst, mean) = relative_error(&full, &inst);
-    let (ri, rf) = (&rows[0], &rows[1]);
+    // Error against time: CSV and plot.
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
+    let mut csv = String::from("method,eps,time_s,peak_rss_bytes,links,error_pct_of_max,error_mean_pct_of_max\n");
+    for (r, worst, mean) in &points {
+        csv += &format!("{},{},{},{},{},{},{}\n", r.method, r.eps, r.seconds, r.peak_rss_bytes, r.links, 100.0 * worst, 100.0 * mean);
+    }
+    let csv_path = args.out.join("instancing_error_time.csv");
+    std::fs::write(&csv_path, csv).with_context(|| format!("{}: cannot write", csv_path.display()))?;
+    let plotted: Vec<(String, f64, f64, f64)> =
+        points.iter().filter(|p| p.1 > 0.0).map(|(r, worst, _)| (r.method.clone(), r.seconds, 100.0 * worst, 0.0)).collect();
+    let svg_path = args.out.join("instancing_error_time.svg");
+    let title = format!("tree age {} (reference: full at eps {})", args.age, args.eps);
+    std::fs::write(&svg_path, super::sweep::svg_plot(&title, &plotted)).with_context(|| format!("{}: cannot write", svg_path.display()))?;
+
+    let (rf, ri, worst, mean) = (&points[0].0, &points[1].0, points[1].1, points[1].2);
     if args.json {
         let doc = serde_json::json!({
             "tree": {
+                "age": args.age,
                 "polygons": rf.polygons,
+                "eps": args.eps,
                 "full": {"time_s": rf.seconds, "peak_rss_bytes": rf.peak_rss_bytes, "links": rf.links},
                 "instanced": {"time_s": ri.seconds, "peak_rss_bytes": ri.peak_rss_bytes, "links": ri.links},
                 "error_pct_of_max": 100.0 * worst,
                 "error_mean_pct_of_max": 100.0 * mean,
             },
-            "forests": [],
+            "error_time": points.iter().map(|(r, w, m)| serde_json::json!({
+                "method": r.method, "eps": r.eps, "time_s": r.seconds, "peak_rss_bytes": r.peak_rss_bytes,
+                "links": r.links, "error_pct_of_max": 100.0 * w, "error_mean_pct_of_max": 100.0 * m,
+            })).collect::<Vec<_>>(),
+            "forests": forests.iter().map(|(trees, r)| serde_json::json!({
+                "trees": trees, "polygons": r.polygons, "time_s": r.seconds, "peak_rss_bytes": r.peak_rss_bytes, "links": r.links,
+            })).collect::<Vec<_>>(),
         });
         println!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(());
     }
     println!("tree age {} seed {}, {} polygons (two-sided leaves as pairs), eps {}", args.age, args.seed, rf.polygons, args.eps);
-    println!("{:<10} {:>10} {:>10} {:>10} {:>8}", "method", "time_s", "peak_MB", "links", "solves");
-    for r in &rows {
-        println!("{:<10} {:>10.3} {:>10.1} {:>10} {:>8}", r.method, r.seconds, r.peak_rss_bytes as f64 / 1e6, r.links, r.local_solves);
+    println!(
+        "{:<10} {:>7} {:>10} {:>10} {:>10} {:>8} {:>10} {:>10}",
+        "method", "eps", "time_s", "peak_MB", "links", "solves", "err_max%", "err_mean%"
+    );
+    for (r, w, m) in &points {
+        println!(
+            "{:<10} {:>7} {:>10.3} {:>10.1} {:>10} {:>8} {:>10.2} {:>10.3}",
+            r.method,
+            r.eps,
+            r.seconds,
+            r.peak_rss_bytes as f64 / 1e6,
+            r.links,
+            r.local_solves,
+            100.0 * w,
+            100.0 * m
+        );
     }
     println!(
-        "instanced vs full: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity",
+        "instanced vs full at eps {}: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity",
+        args.eps,
         rf.seconds / ri.seconds.max(1e-9),
         rf.peak_rss_bytes as f64 / ri.peak_rss_bytes.max(1) as f64,
         100.0 * worst,
         100.0 * mean
     );
+    if !forests.is_empty() {
+        println!("{:<8} {:>12} {:>10} {:>10} {:>12}", "trees", "polygons", "time_s", "peak_MB", "links");
+        for (trees, r) in &forests {
+            println!("{:<8} {:>12} {:>10.1} {:>10.1} {:>12}", trees, r.polygons, r.seconds, r.peak_rss_bytes as f64 / 1e6, r.links);
+        }
+    }
+    println!("wrote {} and {}", csv_path.display(), svg_path.display());
     Ok(())
 }

@@ -182,7 +182,9 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
 
 /// A log–log plot of error (% of max) against run time, one series per oracle, with the estimates
 /// as hollow marks. Written by hand: a few dozen lines of SVG, no plotting dependency.
-fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> String {
+/// Error against run time, log–log: `(series, time_s, error %, estimate %)` points (estimates as
+/// hollow circles where positive).
+pub fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> String {
     let (w, h, m) = (640.0, 420.0, 60.0);
     let pos: Vec<&(String, f64, f64, f64)> = points.iter().filter(|p| p.1 > 0.0 && p.2 > 0.0).collect();
     let lx = |v: f64| v.log10();

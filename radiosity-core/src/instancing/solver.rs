@@ -483,8 +483,12 @@ fn collect_leaves(h: &Hierarchy, e: ElementId, f: &mut dyn FnMut(ElementId)) {
 pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(PolygonMeans, u64), InstancingError> {
     let flat = super::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
     // No error estimate: the comparison measures the error, and the instanced solve has none either.
-    let solved =
-        pipeline::run(&flat, &BfHand { params: config.bf }, &pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline }, &|_| {});
+    let solved = pipeline::run(
+        &flat,
+        &BfHand { params: config.bf },
+        &pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline },
+        &|_| {},
+    );
     let mut means = PolygonMeans::default();
     let mut leaves = Vec::new();
     for i in 0..flat.polygons.len() {
