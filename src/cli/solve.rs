@@ -128,7 +128,8 @@ fn solve_instanced(args: &SolveArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let path = args.scene.as_ref().expect("checked by the caller");
     let scene = instancing::load(path)?;
-    let mut config = InstancedConfig { cache_dir: Some(args.out.join("prototype-cache")), ..InstancedConfig::default() };
+    let trace = std::env::var_os("RADIOSITY_TRACE").is_some();
+    let mut config = InstancedConfig { cache_dir: Some(args.out.join("prototype-cache")), trace, ..InstancedConfig::default() };
     config.bf.eps = args.options.eps;
     config.pipeline = args.options.config();
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);

@@ -60,6 +60,10 @@ pub struct InstancedConfig {
     /// problem (one vector of all elements per iteration), and a relative residual of 1e-7 is far
     /// below the method's approximation error.
     pub local_solve: crate::solve::SolveConfig,
+    /// Budget of a local problem's leaf-resolution operator (coefficients of 12 bytes); a larger
+    /// problem (the top level of a forest) does one leaf-level gather pass instead. It caps the
+    /// second-largest allocation of a local problem.
+    pub local_leaf_operator_max_entries: usize,
 }
 
 impl Default for InstancedConfig {
@@ -73,6 +77,7 @@ impl Default for InstancedConfig {
             incoming_rays: 64,
             trace: false,
             local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
+            local_leaf_operator_max_entries: 250_000,
         }
     }
 }
@@ -338,17 +343,26 @@ pub fn solve_instanced(
 
         // Solve, stream, keep only the proxies' irradiance.
         let t_local = std::time::Instant::now();
-        let local_config = pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline };
+        let local_config = pipeline::Config {
+            estimate_error: false,
+            solve: config.local_solve,
+            leaf_operator_max_entries: config.local_leaf_operator_max_entries,
+            ..config.pipeline
+        };
         let solved = pipeline::run(&local, &oracle, &local_config, &|_| {});
         if config.trace {
             eprintln!(
-                "local solve {}: `{}` {} polygons ({} proxies), {} links, {:.3}s",
+                "local solve {}: `{}` {} polygons ({} proxies), {} elements, {} links, {} leaf-operator entries, {} iterations, {:.3}s, peak RSS {:.1} MB",
                 stats.local_solves + 1,
                 scene.prototype(task.prototype).name,
                 local.polygons.len(),
                 closed.len(),
+                solved.hierarchy.len(),
                 solved.links.len(),
-                t_local.elapsed().as_secs_f64()
+                solved.leaf_entries,
+                solved.iterations,
+                t_local.elapsed().as_secs_f64(),
+                peak_rss_bytes().unwrap_or(0) as f64 / 1e6
             );
         }
         stats.local_solves += 1;
