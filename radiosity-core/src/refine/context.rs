@@ -173,7 +173,7 @@ impl<'a> LinkCtx<'a> {
         }
         let v = match (self.services.caster, self.services.shafts) {
             (None, _) => 1.0,
-            (Some(_), Some(shafts)) => {
+            (Some(caster), Some(shafts)) => {
                 use crate::visibility::shaft::{self, ShaftClass};
                 use std::sync::atomic::Ordering;
                 match self.shaft_verdict().expect("shafts enabled") {
@@ -188,10 +188,15 @@ impl<'a> LinkCtx<'a> {
                     ShaftClass::Partial { .. } => {
                         let config = VisibilityConfig { rays, ..self.services.visibility };
                         let cands = self.shaft_candidates().expect("classified above");
-                        let (v, n) =
-                            shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &cands, &config);
-                        shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
-                        v
+                        let h = self.services.hierarchy;
+                        if shaft::n_polygons_among(shafts.objects, &cands) > shaft::MAX_LOOP_POLYGONS {
+                            // Long lists: the scene's BVH draws the same segments and is faster.
+                            caster.visibility(h, self.emitter, self.receiver, &config)
+                        } else {
+                            let (v, n) = shaft::visibility_among(shafts.objects, h, self.emitter, self.receiver, &cands, &config);
+                            shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
+                            v
+                        }
                     }
                 }
             }

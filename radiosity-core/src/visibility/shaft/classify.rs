@@ -77,6 +77,10 @@ pub fn classify(
     receiver: ElementId,
     parent_candidates: Option<&[u32]>,
 ) -> ShaftVerdict {
+    if parent_candidates.is_some_and(<[u32]>::is_empty) {
+        // The parent link's shaft contains this one and nothing entered it: no shaft to build.
+        return ShaftVerdict { class: ShaftClass::Visible, candidates: Vec::new(), occluder: None };
+    }
     let shaft = shaft_of(h, emitter, receiver);
     let mut candidates = objects.candidates(&shaft, parent_candidates);
     // Polygons that are the link's own surfaces (kept by every descendant link of a surface).

@@ -34,4 +34,4 @@ pub use obb::Obb;
 pub use objects::{BoundingVolume, ConvexSolid, ObjectConfig, SOLID_REL_TOL, ShaftObject, ShaftObjects};
 pub use occlusion::{OCCLUSION_REL_TOL, convex_polygon_occludes, plate_occludes, solid_occludes};
 pub use plane::{Plane, aabb_corners};
-pub use rays::{SEGMENT_END_EPS, segment_clear_among, visibility_among};
+pub use rays::{MAX_LOOP_POLYGONS, SEGMENT_END_EPS, n_polygons_among, segment_clear_among, visibility_among};
