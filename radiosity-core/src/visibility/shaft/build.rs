@@ -189,6 +189,14 @@ impl Shaft {
             && b.max.z >= e.min.z - t
     }
 
+    /// How deep the box reaches into the extent box: the smallest, over the extent's 6 faces, of how
+    /// far the box's deepest point lies inside the face (negative when it lies outside one).
+    #[must_use]
+    #[inline]
+    pub fn extent_depth(&self, b: &Aabb) -> f64 {
+        (self.extent.max - b.min).min(b.max - self.extent.min).min_element()
+    }
+
     /// Conservative test of a finite point set's convex hull: false only when every point lies
     /// outside one same plane of the shaft. Exact for each plane (the support function of the hull).
     #[must_use]

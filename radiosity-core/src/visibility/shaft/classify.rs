@@ -3,10 +3,10 @@
 //! decide whether the link is certainly invisible, certainly visible, or partial.
 
 use super::build::Shaft;
-use super::cull::may_intersect_obb;
-use super::objects::{BoundingVolume, ShaftObjects};
+use super::objects::ShaftObjects;
 use super::occlusion::{convex_polygon_occludes, plate_occludes, solid_occludes};
-use super::plane::{aabb_corners, min_dot_aabb};
+use super::plane::aabb_corners;
+use super::rays::segment_meets_box;
 use crate::geom::DVec3;
 use crate::hierarchy::{ElementId, Hierarchy};
 
@@ -82,13 +82,13 @@ pub fn classify(
         return ShaftVerdict { class: ShaftClass::Visible, candidates: Vec::new(), occluder: None };
     }
     let shaft = shaft_of(h, emitter, receiver);
-    let mut candidates = objects.candidates(&shaft, parent_candidates);
     // Polygons that are the link's own surfaces (kept by every descendant link of a surface).
     let own: [Option<u32>; 2] = [h.get(emitter).polygon(), h.get(receiver).polygon()];
     let is_own = |p: u32| own.contains(&Some(p));
     let graze = GRAZE_REL_TOL * shaft.extent.diagonal();
+    let mut candidates: Vec<u32> = Vec::with_capacity(parent_candidates.map_or(16, <[u32]>::len));
     let mut blocking: Vec<u32> = Vec::new();
-    candidates.retain(|&id| {
+    objects.visit_candidates(&shaft, parent_candidates, |id, depth| {
         let polys = objects.polygons_of(id);
         if polys.iter().any(|&p| is_own(p)) {
             // The object's bounding volume holds a link surface: judge its other polygons one by one.
@@ -101,25 +101,35 @@ pub fn classify(
                 if reach > graze {
                     blocking.push(id);
                 }
-                return true;
+                candidates.push(id);
             }
-            return false;
+            return;
         }
-        if reaches_deeper(objects, &shaft, id, graze) {
+        if depth > graze {
             blocking.push(id);
         }
-        true
+        candidates.push(id);
     });
+    if parent_candidates.is_none() {
+        // The BVH visits in its own order; lists are kept sorted by id.
+        candidates.sort_unstable();
+        blocking.sort_unstable();
+    }
     if blocking.is_empty() {
         return ShaftVerdict { class: ShaftClass::Visible, candidates, occluder: None };
     }
     let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
+    // An occluder must block every segment, so its box must meet a few chosen ones: the segment
+    // between the centres and those between corresponding vertices. Only candidates that pass try
+    // the exact (and costlier) test.
+    let probes = probe_segments(&pv, &qv);
+    blocking.retain(|&id| probes.iter().all(|&(a, b)| segment_meets_box(a, b, &objects.objects[id as usize].aabb)));
     // Try the largest candidates only: an occluder that blocks a whole shaft is big compared with
     // the others, and testing fewer never makes the answer less conservative.
     let n_blocking = blocking.len() as u32;
     if blocking.len() > MAX_OCCLUDER_TESTS {
         let size = |id: &u32| objects.objects[*id as usize].aabb.diagonal();
-        blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)));
+        blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)).then(a.cmp(b)));
         blocking.truncate(MAX_OCCLUDER_TESTS);
     }
     for &id in &blocking {
@@ -128,6 +138,22 @@ pub fn classify(
         }
     }
     ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None }
+}
+
+/// Most probe segments per link: the centres' segment and up to this many minus one vertex pairs.
+const MAX_PROBES: usize = 9;
+
+/// Segments between the hulls of `p` and `q` that every occluder must block: centre to centre,
+/// and vertex `k` of `p` to vertex `k` of `q`.
+fn probe_segments(p: &[DVec3], q: &[DVec3]) -> Vec<(DVec3, DVec3)> {
+    let mean = |v: &[DVec3]| v.iter().copied().sum::<DVec3>() / v.len().max(1) as f64;
+    let mut out = Vec::with_capacity(MAX_PROBES);
+    if p.is_empty() || q.is_empty() {
+        return out;
+    }
+    out.push((mean(p), mean(q)));
+    out.extend(p.iter().zip(q).take(MAX_PROBES - 1).map(|(&a, &b)| (a, b)));
+    out
 }
 
 /// Whether object `id` blocks every segment between the hulls of `p` and `q` on its own, as a closed
@@ -150,21 +176,4 @@ pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: 
 /// how far the deepest point lies inside that plane (negative when outside some plane).
 fn depth_into(shaft: &Shaft, points: &[DVec3]) -> f64 {
     shaft.planes().map(|pl| pl.offset - pl.min_over_points(points)).fold(f64::INFINITY, f64::min)
-}
-
-/// Whether the object's bounding volume reaches deeper than `graze` into the shaft on every plane.
-fn reaches_deeper(objects: &ShaftObjects, shaft: &Shaft, id: u32, graze: f64) -> bool {
-    let o = &objects.objects[id as usize];
-    let box_depth = shaft.planes().map(|pl| pl.offset - min_dot_aabb(pl.normal, &o.aabb)).fold(f64::INFINITY, f64::min);
-    if box_depth <= graze {
-        return false;
-    }
-    match objects.volume {
-        BoundingVolume::Aabb => true,
-        BoundingVolume::Obb => shaft.planes().all(|pl| pl.offset - o.obb.min_along(&pl) > graze),
-        BoundingVolume::Hull => match objects.hull_of(id) {
-            Some(points) => depth_into(shaft, points) > graze,
-            None => may_intersect_obb(shaft, &o.obb) && shaft.planes().all(|pl| pl.offset - o.obb.min_along(&pl) > graze),
-        },
-    }
 }
