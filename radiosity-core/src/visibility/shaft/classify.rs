@@ -77,6 +77,23 @@ pub fn classify(
     receiver: ElementId,
     parent_candidates: Option<&[u32]>,
 ) -> ShaftVerdict {
+    classify_with(objects, h, emitter, receiver, parent_candidates, usize::MAX)
+}
+
+/// [`classify`] that tries the occlusion tests only when the candidates hold at most
+/// `max_occlusion_polygons` polygons, and otherwise answers partial (conservative: the class is
+/// never invisible or visible where [`classify`] says otherwise, it may be partial instead of
+/// invisible). Where a link's segments are cast through the scene's BVH anyway (long lists, see
+/// [`super::MAX_LOOP_POLYGONS`]), the tests cost about as much as the rays they could save.
+#[must_use]
+pub fn classify_with(
+    objects: &ShaftObjects,
+    h: &Hierarchy,
+    emitter: ElementId,
+    receiver: ElementId,
+    parent_candidates: Option<&[u32]>,
+    max_occlusion_polygons: usize,
+) -> ShaftVerdict {
     if parent_candidates.is_some_and(<[u32]>::is_empty) {
         // The parent link's shaft contains this one and nothing entered it: no shaft to build.
         return ShaftVerdict { class: ShaftClass::Visible, candidates: Vec::new(), occluder: None };
@@ -118,6 +135,10 @@ pub fn classify(
     if blocking.is_empty() {
         return ShaftVerdict { class: ShaftClass::Visible, candidates, occluder: None };
     }
+    let n_blocking = blocking.len() as u32;
+    if max_occlusion_polygons < usize::MAX && super::rays::n_polygons_among(objects, &candidates) > max_occlusion_polygons {
+        return ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None };
+    }
     let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
     // An occluder must block every segment, so its box must meet a few chosen ones: the segment
     // between the centres and those between corresponding vertices. Only candidates that pass try
@@ -126,7 +147,6 @@ pub fn classify(
     blocking.retain(|&id| probes.iter().all(|&(a, b)| segment_meets_box(a, b, &objects.objects[id as usize].aabb)));
     // Try the largest candidates only: an occluder that blocks a whole shaft is big compared with
     // the others, and testing fewer never makes the answer less conservative.
-    let n_blocking = blocking.len() as u32;
     if blocking.len() > MAX_OCCLUDER_TESTS {
         let size = |id: &u32| objects.objects[*id as usize].aabb.diagonal();
         blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)).then(a.cmp(b)));
