@@ -178,7 +178,9 @@ impl<'a> LinkCtx<'a> {
                 use std::sync::atomic::Ordering;
                 let h = self.services.hierarchy;
                 // A classification the oracle asked for is reused; otherwise a light one is made,
-                // without occlusion tests where the segments go through the BVH anyway.
+                // without occlusion tests: they cost more than the few segments they could save
+                // (measured on the bench scenes), and an occluded link's segments all come out
+                // blocked anyway.
                 let light;
                 let parent_len = self.parent_candidates.as_deref().map_or(usize::MAX, <[u32]>::len);
                 let (class, cands): (ShaftClass, &[u32]) = match &self.shaft {
@@ -192,14 +194,8 @@ impl<'a> LinkCtx<'a> {
                         return v;
                     }
                     None => {
-                        light = shaft::classify_with(
-                            shafts.objects,
-                            h,
-                            self.emitter,
-                            self.receiver,
-                            self.parent_candidates.as_deref(),
-                            shaft::MAX_LOOP_POLYGONS,
-                        );
+                        light =
+                            shaft::classify_with(shafts.objects, h, self.emitter, self.receiver, self.parent_candidates.as_deref(), false);
                         (light.class, &light.candidates)
                     }
                 };

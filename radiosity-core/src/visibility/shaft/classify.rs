@@ -77,14 +77,13 @@ pub fn classify(
     receiver: ElementId,
     parent_candidates: Option<&[u32]>,
 ) -> ShaftVerdict {
-    classify_with(objects, h, emitter, receiver, parent_candidates, usize::MAX)
+    classify_with(objects, h, emitter, receiver, parent_candidates, true)
 }
 
-/// [`classify`] that tries the occlusion tests only when the candidates hold at most
-/// `max_occlusion_polygons` polygons, and otherwise answers partial (conservative: the class is
-/// never invisible or visible where [`classify`] says otherwise, it may be partial instead of
-/// invisible). Where a link's segments are cast through the scene's BVH anyway (long lists, see
-/// [`super::MAX_LOOP_POLYGONS`]), the tests cost about as much as the rays they could save.
+/// [`classify`] with the occlusion tests optional: without them the class is never invisible, and
+/// partial where [`classify`] may say invisible (visible and the candidates are the same). For a
+/// link about to be stored, whose segments are cast anyway: the tests cost more than the segments
+/// they could save.
 #[must_use]
 pub fn classify_with(
     objects: &ShaftObjects,
@@ -92,7 +91,7 @@ pub fn classify_with(
     emitter: ElementId,
     receiver: ElementId,
     parent_candidates: Option<&[u32]>,
-    max_occlusion_polygons: usize,
+    occlusion: bool,
 ) -> ShaftVerdict {
     if parent_candidates.is_some_and(<[u32]>::is_empty) {
         // The parent link's shaft contains this one and nothing entered it: no shaft to build.
@@ -136,7 +135,7 @@ pub fn classify_with(
         return ShaftVerdict { class: ShaftClass::Visible, candidates, occluder: None };
     }
     let n_blocking = blocking.len() as u32;
-    if max_occlusion_polygons < usize::MAX && super::rays::n_polygons_among(objects, &candidates) > max_occlusion_polygons {
+    if !occlusion {
         return ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None };
     }
     let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
