@@ -91,6 +91,8 @@ pub struct ShaftObjects {
     /// The bounding volume the shaft tests use.
     pub volume: BoundingVolume,
     pub(super) bvh: super::bvh::ObjectBvh,
+    /// Every input polygon ready for segment tests (`None` when degenerate), with its area.
+    pub(super) prepared: Vec<Option<(f64, super::rays::PreparedPolygon)>>,
 }
 
 impl ShaftObjects {
@@ -110,6 +112,11 @@ impl ShaftObjects {
             solids: Vec::new(),
             merged: Vec::new(),
             polygon_object: vec![u32::MAX; polys.len()],
+            prepared: polys
+                .iter()
+                .enumerate()
+                .map(|(k, p)| super::rays::PreparedPolygon::new(p, k as u32).map(|q| (p.area(), q)))
+                .collect(),
             polys,
             volume: config.volume,
             bvh: super::bvh::ObjectBvh::default(),

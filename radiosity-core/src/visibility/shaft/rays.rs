@@ -5,7 +5,7 @@
 //! (same generator, strata, order and kernel weights), so with a complete candidate list both give
 //! the same estimate up to the `f32` rounding of the global caster.
 
-use super::classify::shaft_of;
+use super::build::SHAFT_REL_TOL;
 use super::objects::ShaftObjects;
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
@@ -19,7 +19,7 @@ pub const SEGMENT_END_EPS: f64 = crate::visibility::SEGMENT_END_EPS as f64;
 /// polygon by polygon ([`visibility_among`]); longer lists go through the scene's BVH, whose cost
 /// per segment grows with its depth rather than with the list. Measured with `radiosity bench
 /// shafts`: on office3 the polygon loop over long lists took 3/4 of the refinement time.
-pub const MAX_LOOP_POLYGONS: usize = 16;
+pub const MAX_LOOP_POLYGONS: usize = 48;
 
 /// Longest inherited candidate list (objects) for which a link about to be stored is classified
 /// before its segments are cast. Measured on the bench scenes: a link whose parent had more
@@ -103,7 +103,8 @@ fn segment_hits_polygon(a: DVec3, d: DVec3, poly: &Poly) -> bool {
 }
 
 /// A polygon ready for many segment tests: its plane and in-plane outward edge planes.
-struct PreparedPolygon {
+#[derive(Clone, Debug)]
+pub(super) struct PreparedPolygon {
     polygon: u32,
     normal: DVec3,
     offset: f64,
@@ -112,7 +113,7 @@ struct PreparedPolygon {
 }
 
 impl PreparedPolygon {
-    fn new(poly: &Poly, polygon: u32) -> Option<PreparedPolygon> {
+    pub(super) fn new(poly: &Poly, polygon: u32) -> Option<PreparedPolygon> {
         let normal = poly.area_vector().try_normalize()?;
         let vs = poly.vertices();
         let mut edges = [(DVec3::ZERO, 0.0); 4];
@@ -146,8 +147,9 @@ impl PreparedPolygon {
 /// fraction when no segment carries weight. Returns the visibility and the number of segments cast. Deterministic for a given seed; correct when `candidates` holds every
 /// object that meets the link's shaft (as [`ShaftObjects::candidates`] guarantees).
 ///
-/// Before casting, the candidates are narrowed to their polygons whose vertices reach the link's
-/// shaft (exact per shaft plane), largest first so that blocked segments stop early.
+/// Before casting, the candidates are narrowed to their polygons whose bounding box meets the
+/// box around both elements (which holds every segment), largest first so that blocked segments
+/// stop early; the polygons' planes and edges are prepared once per scene.
 #[must_use]
 pub fn visibility_among(
     objects: &ShaftObjects,
@@ -157,17 +159,18 @@ pub fn visibility_among(
     candidates: &[u32],
     config: &VisibilityConfig,
 ) -> (f64, u32) {
-    let shaft = shaft_of(h, source, receiver);
+    let extent = h.get(source).bounds.merged(&h.get(receiver).bounds);
+    let pad = SHAFT_REL_TOL * extent.diagonal();
+    let (lo, hi) = (extent.min - pad, extent.max + pad);
     let own = [h.get(source).polygon(), h.get(receiver).polygon()];
-    let mut polys: Vec<(f64, PreparedPolygon)> = Vec::new();
+    let mut polys: Vec<(f64, &PreparedPolygon)> = Vec::new();
     for &id in candidates {
         for &k in objects.polygons_of(id) {
-            let poly = &objects.polys[k as usize];
-            if own.contains(&Some(k)) || !shaft.may_intersect_points(poly.vertices()) {
-                continue;
-            }
-            if let Some(prepared) = PreparedPolygon::new(poly, k) {
-                polys.push((poly.area(), prepared));
+            let Some((area, prepared)) = &objects.prepared[k as usize] else { continue };
+            let vs = objects.polys[k as usize].vertices();
+            let outside = (0..3).any(|a| vs.iter().all(|v| v[a] < lo[a]) || vs.iter().all(|v| v[a] > hi[a]));
+            if !outside && !own.contains(&Some(k)) {
+                polys.push((*area, prepared));
             }
         }
     }
