@@ -7,7 +7,7 @@ use super::objects::ShaftObjects;
 use super::occlusion::{convex_polygon_occludes, plate_occludes, solid_occludes};
 use super::plane::aabb_corners;
 use super::rays::segment_meets_box;
-use crate::geom::DVec3;
+use crate::geom::{Aabb, DVec3};
 use crate::hierarchy::{ElementId, Hierarchy};
 
 /// Depth, relative to the shaft's diagonal, by which an object must reach into the shaft to count
@@ -108,11 +108,14 @@ pub fn classify_with(
         let polys = objects.polygons_of(id);
         if polys.iter().any(|&p| is_own(p)) {
             // The object's bounding volume holds a link surface: judge its other polygons one by one.
-            let reach = polys
-                .iter()
-                .filter(|&&p| !is_own(p))
-                .map(|&p| depth_into(&shaft, objects.polys[p as usize].vertices()))
-                .fold(f64::NEG_INFINITY, f64::max);
+            // The deepest polygon's depth; stops once it is known to exceed `graze`.
+            let mut reach = f64::NEG_INFINITY;
+            for &p in polys.iter().filter(|&&p| !is_own(p)) {
+                reach = reach.max(depth_into_above(&shaft, objects.polys[p as usize].vertices(), reach));
+                if reach > graze {
+                    break;
+                }
+            }
             if reach >= -shaft.tol {
                 if reach > graze {
                     blocking.push(id);
@@ -192,7 +195,16 @@ pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: 
 }
 
 /// How deep the hull of `points` reaches into the shaft: the smallest, over the shaft's planes, of
-/// how far the deepest point lies inside that plane (negative when outside some plane).
-fn depth_into(shaft: &Shaft, points: &[DVec3]) -> f64 {
-    shaft.planes().map(|pl| pl.offset - pl.min_over_points(points)).fold(f64::INFINITY, f64::min)
+/// how far the deepest point lies inside that plane (negative when outside some plane). Stops as
+/// soon as the answer is known to be at most `floor`, returning a value at most `floor` then.
+fn depth_into_above(shaft: &Shaft, points: &[DVec3], floor: f64) -> f64 {
+    // The extent's faces are axis-aligned: the points' box gives their depths exactly.
+    let mut depth = shaft.extent_depth(&Aabb::from_points(points));
+    for pl in shaft.side_planes() {
+        if depth <= floor {
+            break;
+        }
+        depth = depth.min(pl.offset - pl.min_over_points(points));
+    }
+    depth
 }
