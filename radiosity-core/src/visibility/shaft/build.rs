@@ -82,7 +82,7 @@ impl Shaft {
             return shaft;
         }
         // Owner of face (axis, side), side 0 = min, 1 = max.
-        let owner = |axis: usize, side: usize| -> Owner {
+        let owner_of = |axis: usize, side: usize| -> Owner {
             let (ea, eb) = if side == 0 { (-a.min[axis], -b.min[axis]) } else { (a.max[axis], b.max[axis]) };
             if ea > eb {
                 Owner::A
@@ -92,6 +92,8 @@ impl Shaft {
                 Owner::Both
             }
         };
+        let owners: [[Owner; 2]; 3] = std::array::from_fn(|axis| [owner_of(axis, 0), owner_of(axis, 1)]);
+        let owner = |axis: usize, side: usize| owners[axis][side];
         let face = |bx: &Aabb, axis: usize, side: usize| if side == 0 { bx.min[axis] } else { bx.max[axis] };
         // At most 12 edges; the owners' cut has at most MAX_SIDE_PLANES of them.
         let mut planes = [(Plane { normal: DVec3::ZERO, offset: 0.0 }, 0.0f64); 12];

@@ -186,7 +186,16 @@ pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: 
     if objects.solid_of(id).is_some_and(|solid| solid_occludes(p, q, solid)) {
         return true;
     }
-    objects.polygons_of(id).iter().filter(|&&k| !own.contains(&Some(k))).any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
+    // A plate that blocks every segment blocks the one between the centres: the prepared polygons
+    // reject the others cheaply.
+    let mean = |v: &[DVec3]| v.iter().copied().sum::<DVec3>() / v.len().max(1) as f64;
+    let (cp, cq) = (mean(p), mean(q));
+    let crossed = |k: u32| objects.prepared[k as usize].as_ref().is_some_and(|(_, plate)| plate.crossed_by(cp, cq));
+    objects
+        .polygons_of(id)
+        .iter()
+        .filter(|&&k| !own.contains(&Some(k)) && crossed(k))
+        .any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
         || objects
             .merged_of(id)
             .iter()

@@ -124,6 +124,19 @@ impl PreparedPolygon {
         Some(PreparedPolygon { polygon, normal, offset: normal.dot(vs[0]), edges, n_edges: vs.len() })
     }
 
+    /// Whether the segment `a`–`b` crosses the polygon's plane (strictly, anywhere between its
+    /// ends) inside the polygon, edges included.
+    #[inline]
+    pub(super) fn crossed_by(&self, a: DVec3, b: DVec3) -> bool {
+        let sa = self.normal.dot(a) - self.offset;
+        let sb = self.normal.dot(b) - self.offset;
+        if (sa > 0.0) == (sb > 0.0) || sa == sb {
+            return false;
+        }
+        let x = a + (b - a) * (sa / (sa - sb));
+        self.edges[..self.n_edges].iter().all(|&(e, off)| e.dot(x) <= off)
+    }
+
     /// Same contract as [`segment_hits_polygon`] for the segment `a`–`b`.
     #[inline]
     fn hit_by(&self, a: DVec3, b: DVec3) -> bool {
