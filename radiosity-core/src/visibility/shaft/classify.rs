@@ -6,7 +6,7 @@ use super::build::Shaft;
 use super::objects::ShaftObjects;
 use super::occlusion::{convex_polygon_occludes, plate_occludes, solid_occludes};
 use super::plane::aabb_corners;
-use super::rays::segment_meets_box;
+use super::rays::segment_meets_inv;
 use crate::geom::{Aabb, DVec3};
 use crate::hierarchy::{ElementId, Hierarchy};
 
@@ -142,11 +142,6 @@ pub fn classify_with(
         return ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None };
     }
     let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
-    // An occluder must block every segment, so its box must meet a few chosen ones: the segment
-    // between the centres and those between corresponding vertices. Only candidates that pass try
-    // the exact (and costlier) test.
-    let probes = probe_segments(&pv, &qv);
-    blocking.retain(|&id| probes.iter().all(|&(a, b)| segment_meets_box(a, b, &objects.objects[id as usize].aabb)));
     // Try the largest candidates only: an occluder that blocks a whole shaft is big compared with
     // the others, and testing fewer never makes the answer less conservative.
     if blocking.len() > MAX_OCCLUDER_TESTS {
@@ -154,6 +149,11 @@ pub fn classify_with(
         blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)).then(a.cmp(b)));
         blocking.truncate(MAX_OCCLUDER_TESTS);
     }
+    // An occluder must block every segment, so its box must meet a few chosen ones: the segment
+    // between the centres and those between corresponding vertices. Only candidates that pass try
+    // the exact (and costlier) test.
+    let probes = probe_segments(&pv, &qv);
+    blocking.retain(|&id| probes.iter().all(|&(a, inv)| segment_meets_inv(a, inv, &objects.objects[id as usize].aabb)));
     for &id in &blocking {
         if occludes(objects, id, &pv, &qv, &own) {
             return ShaftVerdict { class: ShaftClass::Invisible, candidates, occluder: Some(id) };
@@ -166,15 +166,16 @@ pub fn classify_with(
 const MAX_PROBES: usize = 9;
 
 /// Segments between the hulls of `p` and `q` that every occluder must block: centre to centre,
-/// and vertex `k` of `p` to vertex `k` of `q`.
+/// and vertex `k` of `p` to vertex `k` of `q`, each as its start and the inverse of its direction.
 fn probe_segments(p: &[DVec3], q: &[DVec3]) -> Vec<(DVec3, DVec3)> {
     let mean = |v: &[DVec3]| v.iter().copied().sum::<DVec3>() / v.len().max(1) as f64;
     let mut out = Vec::with_capacity(MAX_PROBES);
     if p.is_empty() || q.is_empty() {
         return out;
     }
-    out.push((mean(p), mean(q)));
-    out.extend(p.iter().zip(q).take(MAX_PROBES - 1).map(|(&a, &b)| (a, b)));
+    let (cp, cq) = (mean(p), mean(q));
+    out.push((cp, (cq - cp).recip()));
+    out.extend(p.iter().zip(q).take(MAX_PROBES - 1).map(|(&a, &b)| (a, (b - a).recip())));
     out
 }
 

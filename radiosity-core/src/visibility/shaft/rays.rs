@@ -56,15 +56,10 @@ pub fn segment_clear_among(objects: &ShaftObjects, candidates: &[u32], a: DVec3,
     true
 }
 
-/// Whether the segment `a`–`b` meets the box (widened as in [`segment_meets_inv`]).
-#[must_use]
-pub(super) fn segment_meets_box(a: DVec3, b: DVec3, bx: &Aabb) -> bool {
-    segment_meets_inv(a, (b - a).recip(), bx)
-}
-
 /// Slab test of the segment `a + t d`, `t` in `[0, 1]`, against a box (`inv` = `1 / d` per axis);
 /// the box is widened by a relative margin so that rounding never misses a polygon on its face.
-fn segment_meets_inv(a: DVec3, inv: DVec3, b: &Aabb) -> bool {
+#[must_use]
+pub(super) fn segment_meets_inv(a: DVec3, inv: DVec3, b: &Aabb) -> bool {
     let pad = 1e-9 * b.diagonal() + f64::MIN_POSITIVE;
     let (lo, hi) = (b.min - pad, b.max + pad);
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
@@ -206,7 +201,7 @@ mod tests {
         assert!(!segment_hits_polygon(DVec3::new(1.5, 0.5, 1.0), d, &q));
         // Ends on the polygon are left out.
         assert!(!segment_hits_polygon(DVec3::new(0.5, 0.5, 2.0), d, &q));
-        assert!(segment_meets_box(DVec3::new(0.5, 0.5, 1.0), DVec3::new(0.5, 0.5, -1.0), &Aabb::from_points(q.vertices())));
+        assert!(segment_meets_inv(DVec3::new(0.5, 0.5, 1.0), d.recip(), &Aabb::from_points(q.vertices())));
         // The prepared test agrees with the plain one.
         let p = PreparedPolygon::new(&q, 0).unwrap();
         for (a, b) in [
