@@ -323,6 +323,19 @@ fn child_solve(
     serde_json::from_str(&text).with_context(|| format!("{}: invalid JSON", path.display()))
 }
 
+/// One method's solves of one scene in `bench shafts`.
+#[derive(Clone)]
+struct ShaftRun {
+    /// `stats.json` of the last solve.
+    stats: serde_json::Value,
+    /// Fastest build + refine + solve time (s).
+    time: f64,
+    /// Fastest refinement time (s).
+    refine: f64,
+    /// Radiosity per input polygon.
+    radiosity: Vec<[f64; 3]>,
+}
+
 fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
     args.options.validate()?;
     anyhow::ensure!((1..=100).contains(&args.repeats), "--repeats must be between 1 and 100");
@@ -339,23 +352,22 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         );
     }
     for (i, scene) in scenes.iter().enumerate() {
-        // Per method: stats of the last solve, fastest total and refinement times, radiosity.
-        let mut runs: Vec<Option<(serde_json::Value, f64, f64, Vec<[f64; 3]>)>> = vec![None; METHODS.len()];
+        let mut runs: Vec<Option<ShaftRun>> = vec![None; METHODS.len()];
         for _ in 0..args.repeats {
             for (m, method) in METHODS.iter().enumerate() {
                 let out = tmp.join(format!("{i}-{method}"));
                 let s = child_solve(&exe, scene, &args.options, method, &out)?;
                 let refine = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN);
                 let time = refine + s["time_s"]["build"].as_f64().unwrap_or(0.0) + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
-                let (best, best_refine) = runs[m].as_ref().map_or((time, refine), |r| (r.1.min(time), r.2.min(refine)));
-                let b = super::read_patches(&out.join("patches.csv"))?;
-                runs[m] = Some((s, best, best_refine, b));
+                let (time, refine) = runs[m].as_ref().map_or((time, refine), |r| (r.time.min(time), r.refine.min(refine)));
+                let radiosity = super::read_patches(&out.join("patches.csv"))?;
+                runs[m] = Some(ShaftRun { stats: s, time, refine, radiosity });
             }
         }
-        let (_, rt, rr, rb) = runs[0].clone().context("at least one run")?;
+        let ShaftRun { time: rt, refine: rr, radiosity: rb, .. } = runs[0].clone().context("at least one run")?;
         let max = rb.iter().flatten().fold(0.0f64, |m, v| m.max(*v)).max(f64::MIN_POSITIVE);
         for (method, run) in METHODS.iter().zip(runs) {
-            let (s, time, refine, b) = run.context("at least one run")?;
+            let ShaftRun { stats: s, time, refine, radiosity: b } = run.context("at least one run")?;
             let d = rb.iter().zip(&b).flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs())).fold(0.0f64, f64::max);
             let (diff, speedup, refine_speedup) = (d / max, rt / time, rr / refine);
             let row = serde_json::json!({
