@@ -171,7 +171,7 @@ pub fn visibility_among(
     let pad = SHAFT_REL_TOL * extent.diagonal();
     let (lo, hi) = (extent.min - pad, extent.max + pad);
     let own = [h.get(source).polygon(), h.get(receiver).polygon()];
-    let mut polys: Vec<(f64, &PreparedPolygon)> = Vec::new();
+    let mut polys: Vec<(f64, &PreparedPolygon)> = Vec::with_capacity(n_polygons_among(objects, candidates));
     for &id in candidates {
         for &k in objects.polygons_of(id) {
             let Some((area, prepared)) = &objects.prepared[k as usize] else { continue };
