@@ -51,12 +51,15 @@ struct Candidate {
     culled_diag: f64,
 }
 
-/// A link that inherits more than [`crate::visibility::shaft::MAX_CULL_PARENT_OBJECTS`] candidates
-/// is split without classifying its shaft (its children inherit the list as it is) until its shaft
-/// is this many times smaller than the one the list was culled for. Long lists seldom shrink, and
+/// A link that inherits more than [`LONG_LIST_OBJECTS`] candidates is split without classifying
+/// its shaft (its children inherit the list as it is) until its shaft is this many times smaller
+/// than the one the list was culled for. Long lists seldom shrink, and
 /// classifying every split link under them cost office3 a fifth of its refinement time for 109
 /// dropped links out of 33,000.
 pub const RECULL_SHRINK: f64 = 0.5;
+
+/// Inherited lists longer than this (objects) count as long for [`RECULL_SHRINK`].
+pub const LONG_LIST_OBJECTS: usize = 4;
 
 enum Outcome {
     Keep(Link, bool),
@@ -168,7 +171,7 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
             // Under a long inherited list the shaft is classified again only once it has shrunk
             // by RECULL_SHRINK; until then the children inherit the list as it is.
             let diag = h.get(c.source).bounds.merged(&h.get(c.receiver).bounds).diagonal();
-            let inherited_long = c.cands.as_deref().is_some_and(|l| l.len() > crate::visibility::shaft::MAX_CULL_PARENT_OBJECTS);
+            let inherited_long = c.cands.as_deref().is_some_and(|l| l.len() > LONG_LIST_OBJECTS);
             if ctx.shaft.is_none() && inherited_long && diag > RECULL_SHRINK * c.culled_diag {
                 return Outcome::Split(d, c.cands.clone(), c.culled_diag);
             }
