@@ -53,6 +53,20 @@ fn check_scene(scene: &Scene) {
         for (&(a, b), &g) in pairs.iter().zip(&global) {
             let verdict = shaft::classify(&objects, &h, a, b, None);
             n_cand += verdict.candidates.len();
+            // Without occlusion tests: the same candidates, and partial where the full test says
+            // invisible (links about to be stored are classified so).
+            let light = shaft::classify_with(&objects, &h, a, b, None, false);
+            let expected = match (verdict.class, light.class) {
+                (ShaftClass::Invisible, ShaftClass::Partial { .. }) => true,
+                (full, light) => full == light,
+            };
+            assert!(
+                expected && light.candidates == verdict.candidates,
+                "{}: {a} -> {b}: {:?} vs light {:?}",
+                scene.name,
+                verdict.class,
+                light.class
+            );
             let v = match verdict.class {
                 ShaftClass::Invisible => {
                     n_inv += 1;

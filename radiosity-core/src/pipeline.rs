@@ -63,8 +63,8 @@ pub enum VisibilityMethod {
     Rays,
     /// Shaft culling with the given bounding volumes: a link whose shaft one occluder blocks is
     /// invisible and one whose shaft nothing enters is visible, both without a ray; other links cast
-    /// rays against the shaft's candidate occluders only. (Each link's candidates are searched
-    /// from the whole scene; inheriting the parent link's list is not wired into the driver yet.)
+    /// rays against the shaft's candidate occluders (or, for long lists, through the BVH); a
+    /// link's candidates are searched among those of the link it was subdivided from.
     Shafts(crate::visibility::shaft::BoundingVolume),
 }
 

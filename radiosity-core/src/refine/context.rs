@@ -173,10 +173,33 @@ impl<'a> LinkCtx<'a> {
         }
         let v = match (self.services.caster, self.services.shafts) {
             (None, _) => 1.0,
-            (Some(_), Some(shafts)) => {
+            (Some(caster), Some(shafts)) => {
                 use crate::visibility::shaft::{self, ShaftClass};
                 use std::sync::atomic::Ordering;
-                match self.shaft_verdict().expect("shafts enabled") {
+                let h = self.services.hierarchy;
+                // A classification the oracle asked for is reused; otherwise a light one is made,
+                // without occlusion tests: they cost more than the few segments they could save
+                // (measured on the bench scenes), and an occluded link's segments all come out
+                // blocked anyway.
+                let light;
+                let parent_len = self.parent_candidates.as_deref().map_or(usize::MAX, <[u32]>::len);
+                let (class, cands): (ShaftClass, &[u32]) = match &self.shaft {
+                    Some((class, cands)) => (*class, cands),
+                    None if parent_len > shaft::MAX_CULL_PARENT_OBJECTS => {
+                        // A long (or no) inherited list seldom shrinks to nothing: culling would
+                        // cost about what the rays cost.
+                        let config = VisibilityConfig { rays, ..self.services.visibility };
+                        let v = caster.visibility(h, self.emitter, self.receiver, &config);
+                        self.data.visibility = Some((v, rays));
+                        return v;
+                    }
+                    None => {
+                        light =
+                            shaft::classify_with(shafts.objects, h, self.emitter, self.receiver, self.parent_candidates.as_deref(), false);
+                        (light.class, &light.candidates)
+                    }
+                };
+                match class {
                     ShaftClass::Invisible => {
                         shafts.invisible.fetch_add(1, Ordering::Relaxed);
                         0.0
@@ -187,11 +210,14 @@ impl<'a> LinkCtx<'a> {
                     }
                     ShaftClass::Partial { .. } => {
                         let config = VisibilityConfig { rays, ..self.services.visibility };
-                        let cands = self.shaft_candidates().expect("classified above");
-                        let (v, n) =
-                            shaft::visibility_among(shafts.objects, self.services.hierarchy, self.emitter, self.receiver, &cands, &config);
-                        shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
-                        v
+                        if shaft::n_polygons_among(shafts.objects, cands) > shaft::MAX_LOOP_POLYGONS {
+                            // Long lists: the scene's BVH draws the same segments and is faster.
+                            caster.visibility(h, self.emitter, self.receiver, &config)
+                        } else {
+                            let (v, n) = shaft::visibility_among(shafts.objects, h, self.emitter, self.receiver, cands, &config);
+                            shafts.rays.fetch_add(u64::from(n), Ordering::Relaxed);
+                            v
+                        }
                     }
                 }
             }

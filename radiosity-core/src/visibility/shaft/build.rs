@@ -82,7 +82,7 @@ impl Shaft {
             return shaft;
         }
         // Owner of face (axis, side), side 0 = min, 1 = max.
-        let owner = |axis: usize, side: usize| -> Owner {
+        let owner_of = |axis: usize, side: usize| -> Owner {
             let (ea, eb) = if side == 0 { (-a.min[axis], -b.min[axis]) } else { (a.max[axis], b.max[axis]) };
             if ea > eb {
                 Owner::A
@@ -92,8 +92,12 @@ impl Shaft {
                 Owner::Both
             }
         };
+        let owners: [[Owner; 2]; 3] = std::array::from_fn(|axis| [owner_of(axis, 0), owner_of(axis, 1)]);
+        let owner = |axis: usize, side: usize| owners[axis][side];
         let face = |bx: &Aabb, axis: usize, side: usize| if side == 0 { bx.min[axis] } else { bx.max[axis] };
-        let mut planes: Vec<(Plane, f64)> = Vec::with_capacity(MAX_SIDE_PLANES);
+        // At most 12 edges; the owners' cut has at most MAX_SIDE_PLANES of them.
+        let mut planes = [(Plane { normal: DVec3::ZERO, offset: 0.0 }, 0.0f64); 12];
+        let mut n_planes = 0;
         let axis_dir = b.center() - a.center();
         let (u, v) = perpendicular_basis(axis_dir);
         for i in 0..3 {
@@ -121,16 +125,18 @@ impl Shaft {
                         p[j] = xj;
                         // di and dj are both > 0 because the owners differ strictly.
                         let Some(plane) = Plane::try_through(n, p) else { continue };
-                        let angle = plane.normal.dot(v).atan2(plane.normal.dot(u));
-                        planes.push((plane, angle));
+                        let angle = pseudo_angle(plane.normal.dot(v), plane.normal.dot(u));
+                        planes[n_planes] = (plane, angle);
+                        n_planes += 1;
                     }
                 }
             }
         }
         // Cyclic order: by the angle of the outward normal about the axis joining the box centres.
+        let planes = &mut planes[..n_planes];
         planes.sort_by(|p, q| p.1.total_cmp(&q.1));
         shaft.kind = if planes.is_empty() && (contains(a, b) || contains(b, a)) { ShaftKind::Nested } else { ShaftKind::Joined };
-        for (k, (plane, _)) in planes.into_iter().take(MAX_SIDE_PLANES).enumerate() {
+        for (k, &(plane, _)) in planes.iter().take(MAX_SIDE_PLANES).enumerate() {
             shaft.sides[k] = plane;
             shaft.n_sides = (k + 1) as u8;
         }
@@ -189,6 +195,14 @@ impl Shaft {
             && b.max.z >= e.min.z - t
     }
 
+    /// How deep the box reaches into the extent box: the smallest, over the extent's 6 faces, of how
+    /// far the box's deepest point lies inside the face (negative when it lies outside one).
+    #[must_use]
+    #[inline]
+    pub fn extent_depth(&self, b: &Aabb) -> f64 {
+        (self.extent.max - b.min).min(b.max - self.extent.min).min_element()
+    }
+
     /// Conservative test of a finite point set's convex hull: false only when every point lies
     /// outside one same plane of the shaft. Exact for each plane (the support function of the hull).
     #[must_use]
@@ -202,6 +216,18 @@ impl Shaft {
         let (ca, cb) = (aabb_corners(&self.a), aabb_corners(&self.b));
         std::array::from_fn(|k| if k < 8 { ca[k] } else { cb[k - 8] })
     }
+}
+
+/// A cheap stand-in for `y.atan2(x)`, increasing with it on `(-π, π]` (the "diamond angle", in
+/// `(-2, 2]`), so that sorting by it gives the same cyclic order without a transcendental call.
+fn pseudo_angle(y: f64, x: f64) -> f64 {
+    let l1 = x.abs() + y.abs();
+    if l1 == 0.0 {
+        return 0.0;
+    }
+    // 1 − x/l1 runs from 0 (direction +x) to 2 (direction −x) over the upper half plane.
+    let half = 1.0 - x / l1;
+    if y >= 0.0 { half } else { -half }
 }
 
 fn contains(outer: &Aabb, inner: &Aabb) -> bool {
@@ -305,6 +331,15 @@ mod tests {
         // Empty box: the shaft is the other box.
         let s = Shaft::new(&Aabb::EMPTY, &bx([0.0; 3], [1.0; 3]));
         assert_eq!((s.kind, s.extent), (ShaftKind::Nested, bx([0.0; 3], [1.0; 3])));
+    }
+
+    #[test]
+    fn pseudo_angle_orders_like_atan2() {
+        let angles: Vec<f64> = (0..720).map(|k| -std::f64::consts::PI + (k as f64 + 0.5) * std::f64::consts::TAU / 720.0).collect();
+        let pseudo: Vec<f64> = angles.iter().map(|t| pseudo_angle(3.0 * t.sin(), 3.0 * t.cos())).collect();
+        assert!(pseudo.windows(2).all(|w| w[0] < w[1]), "not increasing with the angle");
+        assert_eq!(pseudo_angle(0.0, 0.0), 0.0);
+        assert!((pseudo_angle(1.0, 0.0) - 1.0).abs() < 1e-15 && (pseudo_angle(-1.0, 0.0) + 1.0).abs() < 1e-15);
     }
 
     #[test]

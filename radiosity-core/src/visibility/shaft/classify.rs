@@ -3,11 +3,11 @@
 //! decide whether the link is certainly invisible, certainly visible, or partial.
 
 use super::build::Shaft;
-use super::cull::may_intersect_obb;
-use super::objects::{BoundingVolume, ShaftObjects};
+use super::objects::ShaftObjects;
 use super::occlusion::{convex_polygon_occludes, plate_occludes, solid_occludes};
-use super::plane::{aabb_corners, min_dot_aabb};
-use crate::geom::DVec3;
+use super::plane::aabb_corners;
+use super::rays::segment_meets_inv;
+use crate::geom::{Aabb, DVec3};
 use crate::hierarchy::{ElementId, Hierarchy};
 
 /// Depth, relative to the shaft's diagonal, by which an object must reach into the shaft to count
@@ -77,53 +77,106 @@ pub fn classify(
     receiver: ElementId,
     parent_candidates: Option<&[u32]>,
 ) -> ShaftVerdict {
+    classify_with(objects, h, emitter, receiver, parent_candidates, true)
+}
+
+/// [`classify`] with the occlusion tests optional: without them the class is never invisible, and
+/// partial where [`classify`] may say invisible (visible and the candidates are the same). For a
+/// link about to be stored, whose segments are cast anyway: the tests cost more than the segments
+/// they could save.
+#[must_use]
+pub fn classify_with(
+    objects: &ShaftObjects,
+    h: &Hierarchy,
+    emitter: ElementId,
+    receiver: ElementId,
+    parent_candidates: Option<&[u32]>,
+    occlusion: bool,
+) -> ShaftVerdict {
+    if parent_candidates.is_some_and(<[u32]>::is_empty) {
+        // The parent link's shaft contains this one and nothing entered it: no shaft to build.
+        return ShaftVerdict { class: ShaftClass::Visible, candidates: Vec::new(), occluder: None };
+    }
     let shaft = shaft_of(h, emitter, receiver);
-    let mut candidates = objects.candidates(&shaft, parent_candidates);
     // Polygons that are the link's own surfaces (kept by every descendant link of a surface).
     let own: [Option<u32>; 2] = [h.get(emitter).polygon(), h.get(receiver).polygon()];
     let is_own = |p: u32| own.contains(&Some(p));
     let graze = GRAZE_REL_TOL * shaft.extent.diagonal();
+    let mut candidates: Vec<u32> = Vec::with_capacity(parent_candidates.map_or(16, <[u32]>::len));
     let mut blocking: Vec<u32> = Vec::new();
-    candidates.retain(|&id| {
+    objects.visit_candidates(&shaft, parent_candidates, |id, depth| {
         let polys = objects.polygons_of(id);
         if polys.iter().any(|&p| is_own(p)) {
             // The object's bounding volume holds a link surface: judge its other polygons one by one.
-            let reach = polys
-                .iter()
-                .filter(|&&p| !is_own(p))
-                .map(|&p| depth_into(&shaft, objects.polys[p as usize].vertices()))
-                .fold(f64::NEG_INFINITY, f64::max);
+            // The deepest polygon's depth; stops once it is known to exceed `graze`.
+            let mut reach = f64::NEG_INFINITY;
+            for &p in polys.iter().filter(|&&p| !is_own(p)) {
+                reach = reach.max(depth_into_above(&shaft, objects.polys[p as usize].vertices(), reach));
+                if reach > graze {
+                    break;
+                }
+            }
             if reach >= -shaft.tol {
                 if reach > graze {
                     blocking.push(id);
                 }
-                return true;
+                candidates.push(id);
             }
-            return false;
+            return;
         }
-        if reaches_deeper(objects, &shaft, id, graze) {
+        if depth > graze {
             blocking.push(id);
         }
-        true
+        candidates.push(id);
     });
+    if parent_candidates.is_none() {
+        // The BVH visits in its own order; lists are kept sorted by id.
+        candidates.sort_unstable();
+        blocking.sort_unstable();
+    }
     if blocking.is_empty() {
         return ShaftVerdict { class: ShaftClass::Visible, candidates, occluder: None };
+    }
+    let n_blocking = blocking.len() as u32;
+    if !occlusion {
+        return ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None };
     }
     let (pv, qv) = (element_vertices(h, emitter), element_vertices(h, receiver));
     // Try the largest candidates only: an occluder that blocks a whole shaft is big compared with
     // the others, and testing fewer never makes the answer less conservative.
-    let n_blocking = blocking.len() as u32;
     if blocking.len() > MAX_OCCLUDER_TESTS {
         let size = |id: &u32| objects.objects[*id as usize].aabb.diagonal();
-        blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)));
+        blocking.select_nth_unstable_by(MAX_OCCLUDER_TESTS, |a, b| size(b).total_cmp(&size(a)).then(a.cmp(b)));
         blocking.truncate(MAX_OCCLUDER_TESTS);
     }
+    // An occluder must block every segment, so its box must meet a few chosen ones: the segment
+    // between the centres and those between corresponding vertices. Only candidates that pass try
+    // the exact (and costlier) test.
+    let probes = probe_segments(&pv, &qv);
+    blocking.retain(|&id| probes.iter().all(|&(a, inv)| segment_meets_inv(a, inv, &objects.objects[id as usize].aabb)));
     for &id in &blocking {
         if occludes(objects, id, &pv, &qv, &own) {
             return ShaftVerdict { class: ShaftClass::Invisible, candidates, occluder: Some(id) };
         }
     }
     ShaftVerdict { class: ShaftClass::Partial { candidates: n_blocking }, candidates, occluder: None }
+}
+
+/// Most probe segments per link: the centres' segment and up to this many minus one vertex pairs.
+const MAX_PROBES: usize = 9;
+
+/// Segments between the hulls of `p` and `q` that every occluder must block: centre to centre,
+/// and vertex `k` of `p` to vertex `k` of `q`, each as its start and the inverse of its direction.
+fn probe_segments(p: &[DVec3], q: &[DVec3]) -> Vec<(DVec3, DVec3)> {
+    let mean = |v: &[DVec3]| v.iter().copied().sum::<DVec3>() / v.len().max(1) as f64;
+    let mut out = Vec::with_capacity(MAX_PROBES);
+    if p.is_empty() || q.is_empty() {
+        return out;
+    }
+    let (cp, cq) = (mean(p), mean(q));
+    out.push((cp, (cq - cp).recip()));
+    out.extend(p.iter().zip(q).take(MAX_PROBES - 1).map(|(&a, &b)| (a, (b - a).recip())));
+    out
 }
 
 /// Whether object `id` blocks every segment between the hulls of `p` and `q` on its own, as a closed
@@ -134,7 +187,16 @@ pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: 
     if objects.solid_of(id).is_some_and(|solid| solid_occludes(p, q, solid)) {
         return true;
     }
-    objects.polygons_of(id).iter().filter(|&&k| !own.contains(&Some(k))).any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
+    // A plate that blocks every segment blocks the one between the centres: the prepared polygons
+    // reject the others cheaply.
+    let mean = |v: &[DVec3]| v.iter().copied().sum::<DVec3>() / v.len().max(1) as f64;
+    let (cp, cq) = (mean(p), mean(q));
+    let crossed = |k: u32| objects.prepared[k as usize].as_ref().is_some_and(|(_, plate)| plate.crossed_by(cp, cq));
+    objects
+        .polygons_of(id)
+        .iter()
+        .filter(|&&k| !own.contains(&Some(k)) && crossed(k))
+        .any(|&k| plate_occludes(p, q, &objects.polys[k as usize]))
         || objects
             .merged_of(id)
             .iter()
@@ -143,24 +205,16 @@ pub fn occludes(objects: &ShaftObjects, id: u32, p: &[DVec3], q: &[DVec3], own: 
 }
 
 /// How deep the hull of `points` reaches into the shaft: the smallest, over the shaft's planes, of
-/// how far the deepest point lies inside that plane (negative when outside some plane).
-fn depth_into(shaft: &Shaft, points: &[DVec3]) -> f64 {
-    shaft.planes().map(|pl| pl.offset - pl.min_over_points(points)).fold(f64::INFINITY, f64::min)
-}
-
-/// Whether the object's bounding volume reaches deeper than `graze` into the shaft on every plane.
-fn reaches_deeper(objects: &ShaftObjects, shaft: &Shaft, id: u32, graze: f64) -> bool {
-    let o = &objects.objects[id as usize];
-    let box_depth = shaft.planes().map(|pl| pl.offset - min_dot_aabb(pl.normal, &o.aabb)).fold(f64::INFINITY, f64::min);
-    if box_depth <= graze {
-        return false;
+/// how far the deepest point lies inside that plane (negative when outside some plane). Stops as
+/// soon as the answer is known to be at most `floor`, returning a value at most `floor` then.
+fn depth_into_above(shaft: &Shaft, points: &[DVec3], floor: f64) -> f64 {
+    // The extent's faces are axis-aligned: the points' box gives their depths exactly.
+    let mut depth = shaft.extent_depth(&Aabb::from_points(points));
+    for pl in shaft.side_planes() {
+        if depth <= floor {
+            break;
+        }
+        depth = depth.min(pl.offset - pl.min_over_points(points));
     }
-    match objects.volume {
-        BoundingVolume::Aabb => true,
-        BoundingVolume::Obb => shaft.planes().all(|pl| pl.offset - o.obb.min_along(&pl) > graze),
-        BoundingVolume::Hull => match objects.hull_of(id) {
-            Some(points) => depth_into(shaft, points) > graze,
-            None => may_intersect_obb(shaft, &o.obb) && shaft.planes().all(|pl| pl.offset - o.obb.min_along(&pl) > graze),
-        },
-    }
+    depth
 }

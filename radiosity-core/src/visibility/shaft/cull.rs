@@ -5,6 +5,7 @@
 use super::build::Shaft;
 use super::obb::Obb;
 use super::objects::{BoundingVolume, ShaftObjects};
+use super::plane::min_dot_aabb;
 use crate::geom::Aabb;
 
 /// Conservative shaft against oriented box: false only when the box lies entirely outside one of
@@ -40,6 +41,53 @@ impl ShaftObjects {
         }
     }
 
+    /// How deep object `id`'s bounding volume (the one chosen in [`super::ObjectConfig::volume`],
+    /// intersected with its axis-aligned box) reaches into `shaft`: the smallest, over the shaft's
+    /// planes, of how far the volume's deepest point lies inside the plane. Below `-shaft.tol` the
+    /// volume lies outside the shaft (exactly when [`ShaftObjects::may_intersect`] is false); the
+    /// value returned may then stop short of the smallest.
+    #[must_use]
+    pub fn depth_in(&self, shaft: &Shaft, id: u32) -> f64 {
+        let o = &self.objects[id as usize];
+        let mut depth = shaft.extent_depth(&o.aabb);
+        if o.aabb.is_empty() {
+            return f64::NEG_INFINITY;
+        }
+        let hull = match self.volume {
+            BoundingVolume::Hull => self.hull_of(id),
+            _ => None,
+        };
+        for pl in shaft.side_planes() {
+            if depth < -shaft.tol {
+                return depth;
+            }
+            let lowest = min_dot_aabb(pl.normal, &o.aabb);
+            let lowest = match (self.volume, hull) {
+                (BoundingVolume::Aabb, _) => lowest,
+                (BoundingVolume::Hull, Some(points)) => lowest.max(pl.min_over_points(points)),
+                (BoundingVolume::Obb | BoundingVolume::Hull, _) => lowest.max(o.obb.min_along(pl)),
+            };
+            depth = depth.min(pl.offset - lowest);
+        }
+        depth
+    }
+
+    /// Calls `visit(id, depth)` for every object whose bounding volume may meet `shaft` (depth as in
+    /// [`ShaftObjects::depth_in`], at least `-shaft.tol`): the `parent_candidates` in their order, or
+    /// without them the whole scene through the BVH in its fixed traversal order.
+    pub fn visit_candidates(&self, shaft: &Shaft, parent_candidates: Option<&[u32]>, mut visit: impl FnMut(u32, f64)) {
+        let mut test = |id: u32| {
+            let depth = self.depth_in(shaft, id);
+            if depth >= -shaft.tol {
+                visit(id, depth);
+            }
+        };
+        match parent_candidates {
+            Some(list) => list.iter().for_each(|&id| test(id)),
+            None => self.bvh.traverse(|b| shaft.may_intersect_aabb(b), test),
+        }
+    }
+
     /// Objects whose bounding volume may meet `shaft`, in increasing id order. With
     /// `parent_candidates` (the list of a link whose shaft contains this one, e.g. the parent link of
     /// a subdivided link), only those are tested; otherwise the BVH is traversed. Exact for the
@@ -55,19 +103,9 @@ impl ShaftObjects {
     /// [`ShaftObjects::candidates`] appending to `out` (which is cleared first).
     pub fn candidates_into(&self, out: &mut Vec<u32>, shaft: &Shaft, parent_candidates: Option<&[u32]>) {
         out.clear();
-        match parent_candidates {
-            Some(list) => out.extend(list.iter().copied().filter(|&id| self.may_intersect(shaft, id))),
-            None => {
-                self.bvh.traverse(
-                    |b| shaft.may_intersect_aabb(b),
-                    |id| {
-                        if self.may_intersect(shaft, id) {
-                            out.push(id);
-                        }
-                    },
-                );
-                out.sort_unstable();
-            }
+        self.visit_candidates(shaft, parent_candidates, |id, _| out.push(id));
+        if parent_candidates.is_none() {
+            out.sort_unstable();
         }
     }
 }

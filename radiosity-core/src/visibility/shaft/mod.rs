@@ -27,11 +27,11 @@ mod rays;
 
 pub use arena::{CandidateLists, CandidateRange};
 pub use build::{MAX_SIDE_PLANES, SHAFT_REL_TOL, Shaft, ShaftKind};
-pub use classify::{GRAZE_REL_TOL, ShaftClass, ShaftVerdict, classify, element_vertices, occludes, shaft_of};
+pub use classify::{GRAZE_REL_TOL, ShaftClass, ShaftVerdict, classify, classify_with, element_vertices, occludes, shaft_of};
 pub use cull::{may_intersect_aabb, may_intersect_obb};
 pub use merge::{COPLANAR_REL_TOL, MergedPlate};
 pub use obb::Obb;
 pub use objects::{BoundingVolume, ConvexSolid, ObjectConfig, SOLID_REL_TOL, ShaftObject, ShaftObjects};
 pub use occlusion::{OCCLUSION_REL_TOL, convex_polygon_occludes, plate_occludes, solid_occludes};
 pub use plane::{Plane, aabb_corners};
-pub use rays::{SEGMENT_END_EPS, segment_clear_among, visibility_among};
+pub use rays::{MAX_CULL_PARENT_OBJECTS, MAX_LOOP_POLYGONS, SEGMENT_END_EPS, n_polygons_among, segment_clear_among, visibility_among};

@@ -91,6 +91,8 @@ pub struct ShaftObjects {
     /// The bounding volume the shaft tests use.
     pub volume: BoundingVolume,
     pub(super) bvh: super::bvh::ObjectBvh,
+    /// Every input polygon ready for segment tests (`None` when degenerate), with its area.
+    pub(super) prepared: Vec<Option<(f64, super::rays::PreparedPolygon)>>,
 }
 
 impl ShaftObjects {
@@ -110,17 +112,23 @@ impl ShaftObjects {
             solids: Vec::new(),
             merged: Vec::new(),
             polygon_object: vec![u32::MAX; polys.len()],
+            prepared: polys
+                .iter()
+                .enumerate()
+                .map(|(k, p)| super::rays::PreparedPolygon::new(p, k as u32).map(|q| (p.area(), q)))
+                .collect(),
             polys,
             volume: config.volume,
             bvh: super::bvh::ObjectBvh::default(),
         };
         let max_polygons = config.max_polygons.max(1);
+        let centroids: Vec<DVec3> = out.polys.iter().map(Poly::centroid).collect();
         for (g, mut members) in by_group.into_iter().enumerate() {
             if members.is_empty() {
                 continue;
             }
             let mut pieces = Vec::new();
-            split(&out.polys, &mut members, max_polygons, &mut pieces);
+            split(&centroids, &mut members, max_polygons, &mut pieces);
             for piece in pieces {
                 out.push_object(g as u32, &piece, config);
             }
@@ -230,13 +238,14 @@ impl ShaftObjects {
     }
 }
 
-/// Splits `members` into pieces of at most `max` polygons by median cuts along the longest axis.
-fn split(polys: &[Poly], members: &mut [u32], max: usize, out: &mut Vec<Vec<u32>>) {
+/// Splits `members` into pieces of at most `max` polygons by median cuts of their `centroids` along
+/// the longest axis.
+fn split(centroids: &[DVec3], members: &mut [u32], max: usize, out: &mut Vec<Vec<u32>>) {
     if members.len() <= max {
         out.push(members.to_vec());
         return;
     }
-    let centroid = |p: u32| polys[p as usize].centroid();
+    let centroid = |p: u32| centroids[p as usize];
     let mut b = Aabb::EMPTY;
     for &p in members.iter() {
         b.grow(centroid(p));
@@ -245,8 +254,8 @@ fn split(polys: &[Poly], members: &mut [u32], max: usize, out: &mut Vec<Vec<u32>
     let mid = members.len() / 2;
     members.select_nth_unstable_by(mid, |&x, &y| centroid(x)[axis].total_cmp(&centroid(y)[axis]).then(x.cmp(&y)));
     let (lo, hi) = members.split_at_mut(mid);
-    split(polys, lo, max, out);
-    split(polys, hi, max, out);
+    split(centroids, lo, max, out);
+    split(centroids, hi, max, out);
 }
 
 /// The solid closed by `members`, when they bound a convex polyhedron: every vertex lies behind

@@ -74,6 +74,11 @@ pub fn convex_polygon_occludes(p: &[DVec3], q: &[DVec3], vs: &[DVec3]) -> bool {
         return false;
     }
     let Some(plane) = Plane::try_through(loop_normal(vs), mean(vs)) else { return false };
+    // Quick rejection, the cheapest test first: the segment between the elements' centres must
+    // cross the plate.
+    if !crosses_plate(mean(p), mean(q), &plane, vs) {
+        return false;
+    }
     let tol = tolerance(p, q, &Aabb::from_points(vs));
     let (p_min, p_max) = extent_along(p, &plane);
     let (q_min, q_max) = extent_along(q, &plane);
@@ -81,20 +86,18 @@ pub fn convex_polygon_occludes(p: &[DVec3], q: &[DVec3], vs: &[DVec3]) -> bool {
     if !separated {
         return false;
     }
-    // Quick rejection: the segment between the elements' centres must cross the plate.
-    if !crosses_plate(mean(p), mean(q), &plane, vs) {
-        return false;
-    }
-    // In-plane outward edge normals (the polygon is CCW about its normal), unit length.
-    let edge = |k: usize| -> Option<(DVec3, f64)> {
-        let e = (vs[(k + 1) % vs.len()] - vs[k]).cross(plane.normal).try_normalize()?;
-        Some((e, e.dot(vs[k])))
-    };
-    p.iter().all(|&a| {
-        q.iter().all(|&b| {
-            let (ha, hb) = (plane.distance(a), plane.distance(b));
-            let c = a + (b - a) * (ha / (ha - hb));
-            (0..vs.len()).all(|k| edge(k).is_some_and(|(e, off)| e.dot(c) <= off - tol))
+    // Every vertex pair's crossing must lie inside every edge (in-plane outward edge normals, unit
+    // length; the polygon is CCW about its normal), each edge computed once.
+    (0..vs.len()).all(|k| {
+        let Some(e) = (vs[(k + 1) % vs.len()] - vs[k]).cross(plane.normal).try_normalize() else { return false };
+        let off = e.dot(vs[k]) - tol;
+        p.iter().all(|&a| {
+            let ha = plane.distance(a);
+            q.iter().all(|&b| {
+                let hb = plane.distance(b);
+                let c = a + (b - a) * (ha / (ha - hb));
+                e.dot(c) <= off
+            })
         })
     })
 }
