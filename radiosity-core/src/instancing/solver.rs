@@ -6,18 +6,23 @@
 //!   `√(1 − τ̄)` (so that its projected area is the mean effective area ā = (1 − τ̄)·Ā_box), with the
 //!   prototype's mean escape albedo as reflectance; it blocks, absorbs and reflects like the
 //!   prototype on average over directions and takes no self-link (a box face sees no other face);
-//! - opening an instance: the irradiance each face of its proxy received (the links that arrived at
-//!   the instance) is a diffuse light field entering through that face of the instance's box; every
-//!   polygon of the opened level gathers it by [`InstancedConfig::incoming_rays`] cosine-distributed
-//!   rays that leave the box unblocked, and reflects it once as its emission. The local problem is
-//!   then refined and solved with that outside held fixed (its root self-link is the local
-//!   interreflection), its own polygons are streamed to the sink, and its hierarchy is dropped
-//!   before its sub-instances are opened in turn.
+//! - opening an instance: the links that arrived at its proxy (at a face, below it, or at a cluster
+//!   holding it) are sorted by the direction toward their source into [`LIGHT_DIRECTIONS`] bins, and
+//!   each face's irradiance is split over the bins in those proportions; the flux per bin over the
+//!   proxy's projected area in that direction is a field of parallel beams (a distant-light
+//!   model). Every polygon of the opened level gathers the beams by [`InstancedConfig::incoming_rays`]
+//!   rays, drawn toward the beams in proportion to what they bring, that leave the level unblocked,
+//!   and reflects the result once as its emission. The local problem is then refined and solved with
+//!   that outside held fixed (its root self-link is the local interreflection), its own polygons are
+//!   streamed to the sink, and its hierarchy is dropped before its sub-instances are opened in turn;
+//!   the beams that reach a sub-instance's proxy are passed on to it bin by bin.
 //!
 //! Instances whose flattened polygon count exceeds [`InstancedConfig::max_closed_polygons`] are
 //! opened in place (their content joins the current level): the policy that keeps property
-//! computation and every local problem bounded. Memory is bounded by the largest local problem plus
-//! six irradiance values per pending instance; the flattened scene is never built.
+//! computation and every local problem bounded. So are instances nearer to an emitter of their level
+//! than [`InstancedConfig::open_near_emitter`] times their size, where parallel beams would miss
+//! how much brighter their near side is. Memory is bounded by the largest local problem plus one
+//! field ([`LIGHT_DIRECTIONS`] RGB values) per pending instance; the flattened scene is never built.
 
 use super::InstancingError;
 use super::flatten::{FlattenOptions, reversed};
@@ -64,6 +69,10 @@ pub struct InstancedConfig {
     /// problem (the top level of a forest) does one leaf-level gather pass instead. It caps the
     /// second-largest allocation of a local problem.
     pub local_leaf_operator_max_entries: usize,
+    /// An instance whose box lies nearer to an emitter of its level than this many times its own
+    /// diagonal is opened in place: a closed instance receives the light as parallel beams, which
+    /// misses how much brighter its near side is under a close light.
+    pub open_near_emitter: f64,
 }
 
 impl Default for InstancedConfig {
@@ -78,6 +87,7 @@ impl Default for InstancedConfig {
             trace: false,
             local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
             local_leaf_operator_max_entries: 250_000,
+            open_near_emitter: 1.0,
         }
     }
 }
@@ -178,15 +188,16 @@ struct Task {
     prototype: PrototypeId,
     transform: Transform,
     flat_base: u64,
-    /// Irradiance received by the 6 proxy faces (order of [`box_faces`]); `None` at the top.
-    incoming: Option<[[f64; 3]; 6]>,
+    /// The light that arrived at the instance: irradiance perpendicular to each direction of
+    /// [`light_directions`] (a distant-light field); `None` at the top.
+    incoming: Option<Vec<[f64; 3]>>,
 }
 
 /// What a polygon of a local problem stands for.
 #[derive(Clone, Copy)]
 enum Role {
     Own(PolygonInfo),
-    ProxyFace { slot: usize, face: usize },
+    ProxyFace { slot: usize },
 }
 
 /// Solves `scene` depth-first with instances (see the module docs), streaming every finished
@@ -209,15 +220,26 @@ pub fn solve_instanced(
     // largest emission is often a wall's, far below the scene's lights, so its threshold is rescaled
     // to stay relative to the scene's largest emission (the full solve's criterion).
     let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
+    let dirs = light_directions();
     while let Some(task) = stack.pop() {
         // Gather the level: own polygons of the task and of instances opened in place, and the
         // closed instances.
         let mut own: Vec<(Poly, u32, u64, PrototypeId)> = Vec::new();
         let mut closed: Vec<(PrototypeId, Transform, u64)> = Vec::new();
+        let mut emitters: Vec<Aabb> = Vec::new();
         let mut pending = vec![(task.prototype, task.transform, task.flat_base)];
         while let Some((pid, t, base)) = pending.pop() {
             let p = scene.prototype(pid);
             let mut k = base;
+            for q in &p.polygons {
+                if scene.materials[q.material as usize].is_emitter() {
+                    let mut b = Aabb::EMPTY;
+                    for v in t.poly(&q.poly).vertices() {
+                        b.grow(*v);
+                    }
+                    emitters.push(b);
+                }
+            }
             for q in &p.polygons {
                 own.push((t.poly(&q.poly), q.material, k, pid));
                 k += 1;
@@ -229,7 +251,10 @@ pub fn solve_instanced(
             for inst in &p.instances {
                 let c = inst.prototype;
                 let child_t = t.then(&inst.transform);
-                if counts[c as usize] > config.max_closed_polygons || bounds[c as usize].is_empty() {
+                if counts[c as usize] > config.max_closed_polygons
+                    || bounds[c as usize].is_empty()
+                    || near_an_emitter(&child_t.aabb(&bounds[c as usize]), &emitters, config.open_near_emitter)
+                {
                     inline.push((c, child_t, k));
                 } else {
                     closed.push((c, child_t, k));
@@ -297,27 +322,21 @@ pub fn solve_instanced(
                     m
                 }
             };
-            for (face, (_, quad)) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false).into_iter().enumerate() {
+            for (_, quad) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false) {
                 let poly = t.poly(&Poly::quad(quad[0], quad[1], quad[2], quad[3]));
-                add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot, face })?;
+                add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot })?;
             }
         }
         let mut local = b.finish();
         drop(own);
-        // The light that arrived at the instance: each polygon's irradiance from outside, by rays
-        // leaving it through the instance's box (blocked by the level's own geometry and proxies),
-        // each carrying the irradiance its exit face received in the parent. Its first reflection
-        // becomes the polygon's emission; the local solve adds every further interreflection.
-        let external = match &task.incoming {
-            Some(field) => incoming_irradiance(
-                &local,
-                &bounds[task.prototype as usize],
-                &task.transform,
-                field,
-                config.incoming_rays,
-                config.properties.seed,
-            ),
-            None => Vec::new(),
+        // The light that arrived at the instance, a field of parallel beams (one per direction bin),
+        // reaches each polygon by rays toward the beam that leave the level unblocked. Its first
+        // reflection becomes the polygon's emission; the local solve adds every further
+        // interreflection. Proxy faces keep their share per direction, for their own opening.
+        let is_proxy: Vec<bool> = roles.iter().map(|r| matches!(r, Role::ProxyFace { .. })).collect();
+        let (external, external_bins) = match &task.incoming {
+            Some(field) => incoming_irradiance(&local, &dirs, field, &is_proxy, config.incoming_rays, config.properties.seed),
+            None => (Vec::new(), Vec::new()),
         };
         if !external.is_empty() {
             let mut materials = Vec::with_capacity(local.polygons.len());
@@ -369,8 +388,10 @@ pub fn solve_instanced(
         stats.links += solved.links.len() as u64;
         stats.max_local_links = stats.max_local_links.max(solved.links.len() as u64);
         let h = &solved.hierarchy;
-        let mut proxy_irradiance = vec![[[0.0; 3]; 6]; closed.len()];
         let mut leaves = Vec::new();
+        // Per proxy face: its mean irradiance from this level's solve, and how the links that
+        // brought it split over directions.
+        let mut face_irradiance: HashMap<usize, [f64; 3]> = HashMap::new();
         for (i, role) in roles.iter().enumerate() {
             match *role {
                 Role::Own(info) => {
@@ -390,7 +411,7 @@ pub fn solve_instanced(
                     stats.polygons_out += 1;
                     sink.polygon(&info, &leaves)?;
                 }
-                Role::ProxyFace { slot, face } => {
+                Role::ProxyFace { .. } => {
                     let (mut acc, mut area) = ([0.0; 3], 0.0);
                     collect_leaves(h, i as ElementId, &mut |e| {
                         let a = h.get(e).area;
@@ -400,35 +421,142 @@ pub fn solve_instanced(
                         }
                         area += a;
                     });
-                    let ext = external.get(i).copied().unwrap_or([0.0; 3]);
-                    proxy_irradiance[slot][face] = std::array::from_fn(|c| ext[c] + if area > 0.0 { acc[c] / area } else { 0.0 });
+                    let _ = face_irradiance.insert(i, acc.map(|v| if area > 0.0 { v / area } else { 0.0 }));
+                }
+            }
+        }
+        let weights = link_directions(h, &solved.links, &solved.solution.radiosity, &is_proxy, &dirs);
+        let mut fields = vec![vec![[0.0; 3]; dirs.len()]; closed.len()];
+        let mut projected = vec![vec![0.0; dirs.len()]; closed.len()];
+        for (i, role) in roles.iter().enumerate() {
+            let Role::ProxyFace { slot, .. } = *role else { continue };
+            let (area, n) = (local.polygons[i].poly.area(), local.polygons[i].poly.normal());
+            let h_local = face_irradiance.get(&i).copied().unwrap_or([0.0; 3]);
+            let w = weights.get(&i);
+            let total: [f64; 3] = std::array::from_fn(|c| w.map_or(0.0, |w| w.iter().map(|x| x[c]).sum()));
+            for (b, u) in dirs.iter().enumerate() {
+                projected[slot][b] += area * n.dot(*u).max(0.0);
+                for c in 0..3 {
+                    let ext = external_bins.get(i).and_then(|v| v.get(b)).map_or(0.0, |x| x[c]);
+                    let local_share = match w {
+                        Some(w) if total[c] > 0.0 => h_local[c] * w[b][c] / total[c],
+                        // No link to attribute (none arrived, or all from behind): along the normal.
+                        _ if b == nearest_direction(&dirs, n) => h_local[c],
+                        _ => 0.0,
+                    };
+                    fields[slot][b][c] += area * (ext + local_share);
                 }
             }
         }
         drop(solved);
         for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
-            stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(proxy_irradiance[slot]) });
+            let field: Vec<[f64; 3]> =
+                fields[slot].iter().zip(&projected[slot]).map(|(flux, p)| flux.map(|f| if *p > 0.0 { f / p } else { 0.0 })).collect();
+            stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(field) });
         }
     }
     stats.seconds = t0.elapsed().as_secs_f64();
     Ok(stats)
 }
 
-/// Irradiance from outside of every polygon of `local` (see the module docs). `lb` is the opened
-/// prototype's local box, `t` its placement, `field` the irradiance received by its proxy's faces.
+/// True when box `b` lies within `rel` times its diagonal of one of the `emitters` boxes.
+fn near_an_emitter(b: &Aabb, emitters: &[Aabb], rel: f64) -> bool {
+    let reach = rel * b.diagonal();
+    emitters.iter().any(|e| {
+        let gap = DVec3::ZERO.max(e.min - b.max).max(b.min - e.max);
+        gap.length() < reach
+    })
+}
+
+/// Directions of the light field carried into an opened instance (a Fibonacci sphere).
+pub const LIGHT_DIRECTIONS: u32 = 64;
+/// Beams weaker than this fraction of the strongest are not traced.
+pub const FIELD_REL_MIN: f64 = 1e-4;
+
+/// The direction bins of the light field: unit vectors toward where the light comes from.
+fn light_directions() -> Vec<DVec3> {
+    super::properties::sphere_directions(LIGHT_DIRECTIONS)
+}
+
+/// Index of the bin nearest to unit `u`.
+fn nearest_direction(dirs: &[DVec3], u: DVec3) -> usize {
+    let mut best = (0, f64::NEG_INFINITY);
+    for (k, d) in dirs.iter().enumerate() {
+        let c = d.dot(u);
+        if c > best.1 {
+            best = (k, c);
+        }
+    }
+    best.0
+}
+
+/// For every proxy face, how the links that arrived at it (at the face or below, or at a cluster
+/// holding it) split over the direction bins: `F·V·B_source` (RGB) by the bin of the direction
+/// toward the source (for a cluster receiver, weighted by the face's cosine toward it).
+fn link_directions(
+    h: &Hierarchy,
+    links: &[crate::refine::Link],
+    radiosity: &[[f64; 3]],
+    is_proxy: &[bool],
+    dirs: &[DVec3],
+) -> HashMap<usize, Vec<[f64; 3]>> {
+    let mut out: HashMap<usize, Vec<[f64; 3]>> = HashMap::new();
+    let mut add = |face: usize, u: DVec3, w: [f64; 3]| {
+        let bins = out.entry(face).or_insert_with(|| vec![[0.0; 3]; dirs.len()]);
+        let b = nearest_direction(dirs, u);
+        for c in 0..3 {
+            bins[b][c] += w[c];
+        }
+    };
+    for l in links {
+        let (r, src) = (h.get(l.receiver), h.get(l.source));
+        let b_src = radiosity[l.source as usize];
+        match r.kind {
+            crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
+                for &p in &h.cluster_polygons[poly_start as usize..poly_end as usize] {
+                    if !is_proxy.get(p as usize).copied().unwrap_or(false) {
+                        continue;
+                    }
+                    let face = h.get(p);
+                    let u = (src.center - face.center).normalize_or_zero();
+                    let cos = face.normal.dot(u);
+                    if cos > 0.0 {
+                        add(p as usize, u, b_src.map(|x| l.ff * l.vis * x * cos));
+                    }
+                }
+            }
+            _ => {
+                let Some(p) = r.polygon() else { continue };
+                if is_proxy.get(p as usize).copied().unwrap_or(false) {
+                    let u = (src.center - r.center).normalize_or_zero();
+                    add(p as usize, u, b_src.map(|x| l.ff * l.vis * x));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Irradiance from outside of every polygon of `local` (see the module docs): `field` is the
+/// irradiance perpendicular to each beam of `dirs`. Each polygon casts `rays` rays from jittered
+/// points toward beams drawn in proportion to what they would bring (`E·cos`, stratified), and
+/// receives a beam where its ray leaves the level unblocked: an unbiased estimate whose rays go
+/// where the light is. For polygons marked in `keep_bins`, the share of each beam is returned too.
 fn incoming_irradiance(
     local: &crate::scene::Scene,
-    lb: &Aabb,
-    t: &Transform,
-    field: &[[f64; 3]; 6],
+    dirs: &[DVec3],
+    field: &[[f64; 3]],
+    keep_bins: &[bool],
     rays: u32,
     seed: u64,
-) -> Vec<[f64; 3]> {
+) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>) {
     use rayon::prelude::*;
     let caster = crate::visibility::RayCaster::new(local);
-    let inv = t.matrix.inverse();
-    let diag = t.aabb(lb).diagonal().max(f64::MIN_POSITIVE);
-    let k = f64::from(rays.max(1)).sqrt().ceil() as u32;
+    let diag = local.bounds().diagonal().max(f64::MIN_POSITIVE);
+    let strongest = field.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max);
+    let active: Vec<usize> =
+        (0..dirs.len()).filter(|&b| field[b].iter().copied().fold(0.0, f64::max) > FIELD_REL_MIN * strongest).collect();
+    let n_rays = rays.max(1);
     local
         .polygons
         .par_iter()
@@ -436,38 +564,47 @@ fn incoming_irradiance(
         .map(|(i, p)| {
             let n = p.poly.normal();
             let mut rng = crate::visibility::Rng::for_link(seed, i as u32, 0x1C0);
+            let keep = keep_bins.get(i).copied().unwrap_or(false);
+            let mut bins = if keep { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
+            // What each facing beam would bring unblocked, and the cumulative distribution.
+            let mut cdf: Vec<(usize, f64, f64)> = Vec::with_capacity(active.len());
+            let mut total = 0.0;
+            for &b in &active {
+                let cos = n.dot(dirs[b]);
+                let weight = cos * (field[b][0] + field[b][1] + field[b][2]);
+                if cos > 0.0 && weight > 0.0 {
+                    total += weight;
+                    cdf.push((b, cos, total));
+                }
+            }
             let mut acc = [0.0; 3];
-            for s in 0..k * k {
-                let (a, b) = ((f64::from(s % k) + rng.next_f64()) / f64::from(k), (f64::from(s / k) + rng.next_f64()) / f64::from(k));
+            if total <= 0.0 {
+                return (acc, bins);
+            }
+            let mut k = 0;
+            for s in 0..n_rays {
+                let u = (f64::from(s) + rng.next_f64()) / f64::from(n_rays) * total;
+                while k + 1 < cdf.len() && cdf[k].2 < u {
+                    k += 1;
+                }
+                let (b, cos, _) = cdf[k];
                 let x = p.poly.sample(rng.next_f64(), rng.next_f64()) + n * (super::properties::RAY_OFFSET_REL * diag);
-                let d = super::properties::cosine_dir_from(n, a, b);
-                if super::properties::cast(&caster, x, d).is_none() {
-                    let face = exit_face(lb, inv.transform_point3(x), inv.transform_vector3(d));
-                    for c in 0..3 {
-                        acc[c] += field[face][c];
+                if super::properties::cast(&caster, x, dirs[b]).is_some() {
+                    continue;
+                }
+                // Estimator: E·cos / (probability of the beam × rays).
+                let prob = cos * (field[b][0] + field[b][1] + field[b][2]) / total;
+                for c in 0..3 {
+                    let e = field[b][c] * cos / (prob * f64::from(n_rays));
+                    acc[c] += e;
+                    if keep {
+                        bins[b][c] += e;
                     }
                 }
             }
-            acc.map(|v| v / f64::from(k * k))
+            (acc, bins)
         })
-        .collect()
-}
-
-/// The face (order of [`box_faces`]: x−, x+, y−, y+, z−, z+) through which the ray `o + t·d` leaves
-/// the box `b`.
-fn exit_face(b: &Aabb, o: DVec3, d: DVec3) -> usize {
-    let mut best = (0usize, f64::INFINITY);
-    for a in 0..3 {
-        if d[a] == 0.0 {
-            continue;
-        }
-        let (plane, face) = if d[a] > 0.0 { (b.max[a], 2 * a + 1) } else { (b.min[a], 2 * a) };
-        let t = (plane - o[a]) / d[a];
-        if t < best.1 {
-            best = (face, t);
-        }
-    }
-    best.0
+        .unzip()
 }
 
 fn proxy_of(local: &Aabb, props: &RadiativeProperties) -> Proxy {
