@@ -276,7 +276,7 @@ fn shape_of(scene: &Scene, polygons: &[u32]) -> Option<Shape> {
         }
     }
     signature.sort_unstable();
-    if !(wsum > 0.0) || !area.is_finite() {
+    if !wsum.is_finite() || wsum <= 0.0 || !area.is_finite() {
         return None;
     }
     let centroid = csum / wsum;
@@ -301,7 +301,7 @@ fn shape_of(scene: &Scene, polygons: &[u32]) -> Option<Shape> {
     vertices.dedup();
     let cov_trace = cov[0][0] + cov[1][1] + cov[2][2];
     let cov_norm = cov.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
-    if !(radius > 0.0) || !radius.is_finite() {
+    if !radius.is_finite() || radius <= 0.0 {
         return None;
     }
     Some(Shape { signature, centroid, radius, area, cov_trace, cov_norm, vertices })
