@@ -34,6 +34,20 @@ pub struct SolveArgs {
     /// No progress display and no summary.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Instancing of a plain scene: `none` solves it as given; `auto` finds objects (OBJ objects /
+    /// groups) identical up to a rigid transform and solves them as instances of one prototype,
+    /// like a `.toml` scene (`patches.csv` is then in flattening order).
+    #[arg(long, value_enum, default_value_t = Instances::None)]
+    pub instances: Instances,
+}
+
+/// Values of `--instances`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Instances {
+    /// Solve the scene as given.
+    None,
+    /// Instance repeated objects automatically.
+    Auto,
 }
 
 /// Runs `radiosity solve`.
@@ -41,7 +55,18 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     args.options.validate()?;
     anyhow::ensure!((1..=16384).contains(&args.size), "--size must be between 1 and 16384, got {}", args.size);
     if args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"))) {
-        return solve_instanced(args);
+        let path = args.scene.as_ref().expect("checked above");
+        let scene = radiosity::instancing::load(path)?;
+        return solve_instanced(args, &scene, None);
+    }
+    if args.instances == Instances::Auto {
+        let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
+        let t0 = Instant::now();
+        let auto = radiosity::instancing::auto_instance(&scene, &radiosity::instancing::AutoOptions::default());
+        if !args.quiet {
+            println!("{} in {:.3}s", auto.report, t0.elapsed().as_secs_f64());
+        }
+        return solve_instanced(args, &auto.scene, Some(&auto.report));
     }
     let t0 = Instant::now();
     let reporter = Reporter::new(args.quiet);
@@ -120,21 +145,25 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
     println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());
 }
 
-/// An instanced scene (`.toml`): solved depth-first, one instance open at a time, finished polygons
+/// An instanced scene (a `.toml` file, or a plain scene after `--instances auto`, whose `auto`
+/// report goes to `stats.json`): solved depth-first, one instance open at a time, finished polygons
 /// streamed to `patches.csv` and a spool from which `solution.ply` and `image.png` are written at
 /// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
-fn solve_instanced(args: &SolveArgs) -> anyhow::Result<()> {
+fn solve_instanced(
+    args: &SolveArgs,
+    scene: &radiosity::instancing::InstancedScene,
+    auto: Option<&radiosity::instancing::AutoReport>,
+) -> anyhow::Result<()> {
     use radiosity::instancing::{self, InstancedConfig, StreamedOutput};
     let t0 = Instant::now();
-    let path = args.scene.as_ref().expect("checked by the caller");
-    let scene = instancing::load(path)?;
+    let name = args.scene.as_ref().map_or_else(|| scene.name.clone(), |p| p.display().to_string());
     let trace = std::env::var_os("RADIOSITY_TRACE").is_some();
     let mut config = InstancedConfig { cache_dir: Some(args.out.join("prototype-cache")), trace, ..InstancedConfig::default() };
     config.bf.eps = args.options.eps;
     config.pipeline = args.options.config();
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
-    let mut sink = Progressing { inner: StreamedOutput::create(&args.out, &scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
-    let stats = instancing::solve_instanced(&scene, &config, &mut sink)?;
+    let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
+    let stats = instancing::solve_instanced(scene, &config, &mut sink)?;
     sink.reporter.finish();
     let sink = sink.inner;
     let t_out = Instant::now();
@@ -144,7 +173,10 @@ fn solve_instanced(args: &SolveArgs) -> anyhow::Result<()> {
         let _ = std::fs::remove_file(args.out.join("image.png"));
     }
     let mut doc = serde_json::to_value(&stats).context("serialising stats")?;
-    doc["scene"] = serde_json::json!(path.display().to_string());
+    doc["scene"] = serde_json::json!(name);
+    if let Some(report) = auto {
+        doc["auto_instancing"] = serde_json::to_value(report).context("serialising the auto-instancing report")?;
+    }
     doc["oracle"] = serde_json::json!("bf-hand");
     doc["eps"] = serde_json::json!(args.options.eps);
     doc["tone_white"] = serde_json::json!(written.white);

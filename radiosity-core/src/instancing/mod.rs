@@ -42,6 +42,7 @@
 //! sides exact, transmittance dropped); the prototype properties ([`properties`], random-walk method)
 //! account for the transmittance.
 
+pub mod auto;
 pub mod bench;
 mod error;
 pub mod flatten;
@@ -55,6 +56,7 @@ pub mod properties;
 pub mod solver;
 pub mod write;
 
+pub use auto::{AutoOptions, AutoReport, AutoResult, auto_instance};
 pub use error::InstancingError;
 pub use flatten::{FlattenOptions, flatten, flatten_prototype};
 pub use format::{load, parse};
