@@ -30,7 +30,11 @@ fn forest_of_1_2_million_polygons_solves_within_49_mb() {
     let polygons = stats["polygons_out"].as_u64().unwrap();
     assert!(polygons >= FOREST_POLYGONS, "the forest has {polygons} polygons ({text})");
     let peak = stats["peak_rss_bytes"].as_u64().expect("Linux reports the peak RSS");
-    eprintln!("forest: {polygons} polygons, peak RSS {:.1} MB, {:.1} s", peak as f64 / 1e6, stats["time_s"]["total"].as_f64().unwrap_or(f64::NAN));
+    eprintln!(
+        "forest: {polygons} polygons, peak RSS {:.1} MB, {:.1} s",
+        peak as f64 / 1e6,
+        stats["time_s"]["total"].as_f64().unwrap_or(f64::NAN)
+    );
     assert!(peak <= PEAK_RSS_BOUND_BYTES, "peak RSS {:.1} MB exceeds {:.0} MB", peak as f64 / 1e6, PEAK_RSS_BOUND_BYTES as f64 / 1e6);
     for file in ["solution.ply", "patches.csv", "image.png"] {
         assert!(dir.path().join("out").join(file).metadata().unwrap().len() > 0, "{file} is empty");
