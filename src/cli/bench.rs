@@ -146,36 +146,7 @@ fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
         print_header();
     }
     for (i, scene) in scenes.iter().enumerate() {
-        let out = tmp.join(format!("{i}"));
-        let mut cmd = Command::new(&exe);
-        cmd.arg("solve").arg("--quiet").arg("--no-image").arg("--out").arg(&out);
-        if scene != "cornell" {
-            let p = PathBuf::from(scene);
-            anyhow::ensure!(p.exists(), "{scene}: no such file");
-            cmd.arg(&p);
-        }
-        let o = &args.options;
-        cmd.args([
-            "--eps",
-            &o.eps.to_string(),
-            "--rays",
-            &o.common.rays.to_string(),
-            "--seed",
-            &o.common.seed.to_string(),
-            "--min-area",
-            &o.common.min_area.to_string(),
-        ]);
-        if o.common.allow_dark {
-            cmd.arg("--allow-dark");
-        }
-        if o.common.no_visibility {
-            cmd.arg("--no-visibility");
-        }
-        let status = cmd.status().with_context(|| format!("running {}", exe.display()))?;
-        anyhow::ensure!(status.success(), "{scene}: solve failed ({status})");
-        let path = out.join("stats.json");
-        let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
-        let stats: serde_json::Value = serde_json::from_str(&text).with_context(|| format!("{}: invalid JSON", path.display()))?;
+        let stats = child_solve(&exe, scene, &args.options, None, &tmp.join(format!("{i}")))?;
         if !args.json {
             print_row(scene, &stats);
         }
@@ -298,12 +269,13 @@ fn bench_oracle(args: &OracleBenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Solves `scene` in a child process into `out` and returns its `stats.json`.
+/// Solves `scene` in a child process into `out` (with `--visibility` when given) and returns its
+/// `stats.json`.
 fn child_solve(
     exe: &std::path::Path,
     scene: &str,
     o: &SolveOptions,
-    visibility: &str,
+    visibility: Option<&str>,
     out: &std::path::Path,
 ) -> anyhow::Result<serde_json::Value> {
     let mut cmd = Command::new(exe);
@@ -323,7 +295,9 @@ fn child_solve(
         "--min-area",
         &o.common.min_area.to_string(),
     ]);
-    cmd.args(["--visibility", visibility]);
+    if let Some(v) = visibility {
+        cmd.args(["--visibility", v]);
+    }
     if o.common.allow_dark {
         cmd.arg("--allow-dark");
     }
@@ -370,7 +344,7 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         for _ in 0..args.repeats {
             for (m, method) in METHODS.iter().enumerate() {
                 let out = tmp.join(format!("{i}-{method}"));
-                let s = child_solve(&exe, scene, &args.options, method, &out)?;
+                let s = child_solve(&exe, scene, &args.options, Some(method), &out)?;
                 let refine = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN);
                 let time = refine + s["time_s"]["build"].as_f64().unwrap_or(0.0) + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
                 let (time, refine) = runs[m].as_ref().map_or((time, refine), |r| (r.time.min(time), r.refine.min(refine)));
