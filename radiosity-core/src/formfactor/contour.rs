@@ -22,7 +22,7 @@ pub const PARALLEL_SIN_TOL: f64 = 1e-9;
 /// Relative tolerance of the adaptive outer integral.
 pub const OUTER_REL_TOL: f64 = 1e-9;
 /// Edges shorter than this (in the normalised frame, where the pair spans 1) are dropped.
-pub const MIN_EDGE: f64 = 1e-12;
+pub const MIN_EDGE: f64 = 1e-9;
 /// Deepest bisection of the outer integral.
 pub const OUTER_MAX_DEPTH: u32 = 20;
 
@@ -54,7 +54,8 @@ pub fn polygon_polygon(p1: &[DVec3], p2: &[DVec3]) -> f64 {
     sum / (2.0 * PI * (a1 / (scale * scale)))
 }
 
-fn polygon_area(p: &[DVec3]) -> f64 {
+/// Area of a planar polygon.
+pub(crate) fn polygon_area(p: &[DVec3]) -> f64 {
     let mut n = DVec3::ZERO;
     for i in 1..p.len().saturating_sub(1) {
         n += (p[i] - p[0]).cross(p[i + 1] - p[0]);

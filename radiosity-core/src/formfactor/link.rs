@@ -1,6 +1,7 @@
 //! Form factor of a link (receiver ← source), by receiver quadrature of the analytic point-to-polygon
 //! formula for surfaces, and by the isotropic cluster approximation where a cluster is involved.
 
+use super::contour::{polygon_area, polygon_polygon};
 use super::point_polygon::{MAX_CLIPPED, clip_to_halfspace, point_polygon};
 use crate::geom::{DVec3, Poly, PolyKind, quadrature};
 use crate::hierarchy::{Element, Hierarchy};
@@ -87,7 +88,7 @@ pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: Form
         // Near pairs wholly in front of each other (touching walls included): Stokes' double
         // contour integral, exact up to 1e-11 and cheap where receiver quadrature struggles with
         // the log-singular derivatives at a shared edge.
-        return super::contour::polygon_polygon(rp.vertices(), sv);
+        return polygon_polygon(rp.vertices(), sv);
     }
     if separation < NEAR_SEPARATION {
         // Other near pairs (one crosses the other's plane, or they interpenetrate, as leaves on a
@@ -103,53 +104,19 @@ pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: Form
 /// the receiver's part in front of the source's plane to the source's part in front of the
 /// receiver's plane, scaled by the receiver's fraction in front.
 fn clipped_contour(rp: &Poly, rn: DVec3, sv: &[DVec3], sn: DVec3) -> f64 {
+    // A vertex on the clipping plane comes out twice up to rounding; the contour integral drops
+    // the vanishing edge between the copies ([`super::contour::MIN_EDGE`]).
     let rv = rp.vertices();
     let mut rbuf = [DVec3::ZERO; MAX_CLIPPED];
     let mut sbuf = [DVec3::ZERO; MAX_CLIPPED];
-    let scale = rv.iter().chain(sv).map(|v| (*v - rv[0]).length()).fold(0.0, f64::max);
     let nr = clip_to_halfspace(rv, sv[0], sn, &mut rbuf);
-    let nr = drop_repeated(&mut rbuf, nr, CLIP_MERGE_REL * scale);
     let ns = clip_to_halfspace(sv, rv[0], rn, &mut sbuf);
-    let ns = drop_repeated(&mut sbuf, ns, CLIP_MERGE_REL * scale);
-    if nr < 3 || ns < 3 {
-        return 0.0;
-    }
     let area = rp.area();
-    let front_area = polygon_area(&rbuf[..nr]);
-    if area <= 0.0 || front_area <= 0.0 || polygon_area(&sbuf[..ns]) <= 0.0 {
+    if nr < 3 || ns < 3 || area <= 0.0 {
         return 0.0;
     }
-    super::contour::polygon_polygon(&rbuf[..nr], &sbuf[..ns]) * (front_area / area)
-}
-
-/// Clipped vertices closer than this (relative to the pair's extent) are merged: a vertex lying on
-/// the clipping plane comes out twice, up to rounding, and the near-zero edge between the copies
-/// would only add rounding noise to the contour integral.
-pub const CLIP_MERGE_REL: f64 = 1e-9;
-
-/// Removes vertices within `tol` of their predecessor (cyclically) from `buf[..n]`; returns the new
-/// count.
-fn drop_repeated(buf: &mut [DVec3; MAX_CLIPPED], n: usize, tol: f64) -> usize {
-    let mut k = 0;
-    for i in 0..n {
-        if k == 0 || (buf[i] - buf[k - 1]).length() > tol {
-            buf[k] = buf[i];
-            k += 1;
-        }
-    }
-    while k > 1 && (buf[k - 1] - buf[0]).length() <= tol {
-        k -= 1;
-    }
-    k
-}
-
-/// Area of a planar polygon.
-fn polygon_area(p: &[DVec3]) -> f64 {
-    let mut n = DVec3::ZERO;
-    for i in 1..p.len().saturating_sub(1) {
-        n += (p[i] - p[0]).cross(p[i + 1] - p[0]);
-    }
-    0.5 * n.length()
+    let front_area = polygon_area(&rbuf[..nr]);
+    polygon_polygon(&rbuf[..nr], &sbuf[..ns]) * (front_area / area)
 }
 
 /// Tolerance (relative to the element's radius) of "in front of a plane" for choosing the contour
