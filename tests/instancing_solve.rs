@@ -157,7 +157,7 @@ fn streamed_outputs_hold_every_polygon_and_leaf() {
     let mut sink = instancing::StreamedOutput::create(dir.path(), &scene).unwrap();
     let stats = solve_instanced(&scene, &config(), &mut sink).unwrap();
     let render = radiosity_core::output::RenderConfig { width: 64, height: 48, samples: 2 };
-    let summary = sink.finish(&render).unwrap();
+    let summary = sink.finish(Some(&render)).unwrap();
     assert_eq!(summary.leaves, stats.leaves_out);
     // PLY: the header's counts match the streamed leaves and the body's size.
     let bytes = std::fs::read(dir.path().join("solution.ply")).unwrap();

@@ -168,10 +168,7 @@ fn solve_instanced(
     let sink = sink.inner;
     let t_out = Instant::now();
     let render = output::RenderConfig { width: args.size, height: args.size, ..Default::default() };
-    let written = sink.finish(&render)?;
-    if args.no_image {
-        let _ = std::fs::remove_file(args.out.join("image.png"));
-    }
+    let written = sink.finish((!args.no_image).then_some(&render))?;
     let mut doc = serde_json::to_value(&stats).context("serialising stats")?;
     doc["scene"] = serde_json::json!(name);
     if let Some(report) = auto {

@@ -4,7 +4,8 @@
 
 use super::InstancingError;
 use super::model::InstancedScene;
-use super::solver::{InstancedConfig, PolygonMeans, peak_rss_bytes, solve_full, solve_instanced};
+use super::solver::{InstancedConfig, PolygonMeans, solve_full, solve_instanced};
+use crate::output::peak_rss_bytes;
 use std::io::{Read, Write};
 use std::path::Path;
 

@@ -12,7 +12,7 @@
 
 use super::InstancingError;
 use super::model::InstancedScene;
-use super::solver::{Leaf, PolygonInfo, RadiositySink};
+use super::solver::{Leaf, PolygonInfo, RadiositySink, leaf_means};
 use crate::geom::{Aabb, DVec3};
 use crate::output::{RenderConfig, ToneMap};
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -84,9 +84,8 @@ impl StreamedOutput {
         })
     }
 
-    /// The tone map of the streamed solution: the rule of [`ToneMap::from_scene`] (white at 1.3 ×
-    /// the larger of the 95th percentile and 0.3 × the largest non-emitter polygon radiosity), with
-    /// the percentile read from a logarithmic histogram (bins 1/16 of a decade wide).
+    /// The tone map of the streamed solution: [`ToneMap::from_levels`], with the percentile read
+    /// from a logarithmic histogram (bins 1/16 of a decade wide).
     fn tone(&self) -> ToneMap {
         let total: u64 = self.histogram.iter().sum();
         if total == 0 {
@@ -102,20 +101,21 @@ impl StreamedOutput {
             }
         }
         let p95 = (TONE_MIN * 10f64.powf((bin as f64 + 1.0) / TONE_BINS_PER_DECADE)).min(self.max_b);
-        let white = p95.max(0.3 * self.max_b) * 1.3;
-        ToneMap { white: if white > 0.0 { white } else { 1.0 } }
+        ToneMap::from_levels(p95, self.max_b)
     }
 
-    /// Writes `solution.ply` and `image.png` from the spool, then removes it.
-    pub fn finish(mut self, render: &RenderConfig) -> Result<StreamedSummary, InstancingError> {
+    /// Writes `solution.ply` and, with `render`, `image.png` from the spool, then removes it.
+    pub fn finish(mut self, render: Option<&RenderConfig>) -> Result<StreamedSummary, InstancingError> {
         self.csv.flush().map_err(|e| io_err(&self.csv_path, e))?;
         self.spool.flush().map_err(|e| io_err(&self.spool_path, e))?;
         let tone = self.tone();
         self.write_ply(&tone)?;
-        let rgb = self.render(&tone, render)?;
-        let png = self.dir.join("image.png");
-        crate::output::write_png(&png, &rgb, render.width, render.height)
-            .map_err(|e| InstancingError::io(&png, "cannot write image", std::io::Error::other(e)))?;
+        if let Some(render) = render {
+            let rgb = self.render(&tone, render)?;
+            let png = self.dir.join("image.png");
+            crate::output::write_png(&png, &rgb, render.width, render.height)
+                .map_err(|e| InstancingError::io(&png, "cannot write image", std::io::Error::other(e)))?;
+        }
         let _ = std::fs::remove_file(&self.spool_path);
         Ok(StreamedSummary { leaves: self.leaves, white: tone.white })
     }
@@ -238,15 +238,9 @@ impl StreamedOutput {
 
 impl RadiositySink for StreamedOutput {
     fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError> {
-        let (mut area, mut b, mut h) = (0.0, [0.0; 3], [0.0; 3]);
+        let (area, b, h) = leaf_means(leaves);
         let mut rec = Vec::with_capacity(64);
         for leaf in leaves {
-            let a = leaf.poly.area();
-            area += a;
-            for c in 0..3 {
-                b[c] += a * leaf.b[c];
-                h[c] += a * leaf.h[c];
-            }
             let vs = leaf.poly.vertices();
             rec.clear();
             rec.push(vs.len() as u8);
@@ -262,10 +256,6 @@ impl RadiositySink for StreamedOutput {
             self.spool.write_all(&rec).map_err(|e| io_err(&self.spool_path, e))?;
             self.leaves += 1;
             self.vertices += vs.len() as u64;
-        }
-        if area > 0.0 {
-            b = b.map(|v| v / area);
-            h = h.map(|v| v / area);
         }
         let emitter = self.emitter.get(info.material as usize).copied().unwrap_or(false);
         let lum = b[0].max(b[1]).max(b[2]);

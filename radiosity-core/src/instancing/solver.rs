@@ -160,18 +160,27 @@ impl RadiositySink for PolygonMeans {
             self.radiosity.resize(i + 1, [0.0; 3]);
             self.area.resize(i + 1, 0.0);
         }
-        let (mut acc, mut area) = ([0.0; 3], 0.0);
-        for leaf in leaves {
-            let a = leaf.poly.area();
-            for c in 0..3 {
-                acc[c] += a * leaf.b[c];
-            }
-            area += a;
-        }
-        self.radiosity[i] = acc.map(|x| if area > 0.0 { x / area } else { 0.0 });
+        let (area, b, _) = leaf_means(leaves);
+        self.radiosity[i] = b;
         self.area[i] = area;
         Ok(())
     }
+}
+
+/// Total area and area-weighted mean radiosity and irradiance of a polygon's leaves.
+#[must_use]
+pub fn leaf_means(leaves: &[Leaf]) -> (f64, [f64; 3], [f64; 3]) {
+    let (mut area, mut b, mut h) = (0.0, [0.0; 3], [0.0; 3]);
+    for leaf in leaves {
+        let a = leaf.poly.area();
+        area += a;
+        for c in 0..3 {
+            b[c] += a * leaf.b[c];
+            h[c] += a * leaf.h[c];
+        }
+    }
+    let mean = |x: f64| if area > 0.0 { x / area } else { 0.0 };
+    (area, b.map(mean), h.map(mean))
 }
 
 /// A closed instance's stand-in, per prototype.
@@ -232,16 +241,11 @@ pub fn solve_instanced(
             let p = scene.prototype(pid);
             let mut k = base;
             for q in &p.polygons {
+                let poly = t.poly(&q.poly);
                 if scene.materials[q.material as usize].is_emitter() {
-                    let mut b = Aabb::EMPTY;
-                    for v in t.poly(&q.poly).vertices() {
-                        b.grow(*v);
-                    }
-                    emitters.push(b);
+                    emitters.push(Aabb::from_points(poly.vertices()));
                 }
-            }
-            for q in &p.polygons {
-                own.push((t.poly(&q.poly), q.material, k, pid));
+                own.push((poly, q.material, k, pid));
                 k += 1;
                 if scene.materials[q.material as usize].two_sided {
                     k += 1;
@@ -381,7 +385,7 @@ pub fn solve_instanced(
                 solved.leaf_entries,
                 solved.iterations,
                 t_local.elapsed().as_secs_f64(),
-                peak_rss_bytes().unwrap_or(0) as f64 / 1e6
+                crate::output::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
             );
         }
         stats.local_solves += 1;
@@ -431,6 +435,7 @@ pub fn solve_instanced(
         for (i, role) in roles.iter().enumerate() {
             let Role::ProxyFace { slot, .. } = *role else { continue };
             let (area, n) = (local.polygons[i].poly.area(), local.polygons[i].poly.normal());
+            let along_normal = nearest_direction(&dirs, n);
             let h_local = face_irradiance.get(&i).copied().unwrap_or([0.0; 3]);
             let w = weights.get(&i);
             let total: [f64; 3] = std::array::from_fn(|c| w.map_or(0.0, |w| w.iter().map(|x| x[c]).sum()));
@@ -441,7 +446,7 @@ pub fn solve_instanced(
                     let local_share = match w {
                         Some(w) if total[c] > 0.0 => h_local[c] * w[b][c] / total[c],
                         // No link to attribute (none arrived, or all from behind): along the normal.
-                        _ if b == nearest_direction(&dirs, n) => h_local[c],
+                        _ if b == along_normal => h_local[c],
                         _ => 0.0,
                     };
                     fields[slot][b][c] += area * (ext + local_share);
@@ -567,14 +572,14 @@ fn incoming_irradiance(
             let keep = keep_bins.get(i).copied().unwrap_or(false);
             let mut bins = if keep { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
             // What each facing beam would bring unblocked, and the cumulative distribution.
-            let mut cdf: Vec<(usize, f64, f64)> = Vec::with_capacity(active.len());
+            let mut cdf: Vec<(usize, f64, f64, f64)> = Vec::with_capacity(active.len());
             let mut total = 0.0;
             for &b in &active {
                 let cos = n.dot(dirs[b]);
                 let weight = cos * (field[b][0] + field[b][1] + field[b][2]);
                 if cos > 0.0 && weight > 0.0 {
                     total += weight;
-                    cdf.push((b, cos, total));
+                    cdf.push((b, cos, weight, total));
                 }
             }
             let mut acc = [0.0; 3];
@@ -584,16 +589,16 @@ fn incoming_irradiance(
             let mut k = 0;
             for s in 0..n_rays {
                 let u = (f64::from(s) + rng.next_f64()) / f64::from(n_rays) * total;
-                while k + 1 < cdf.len() && cdf[k].2 < u {
+                while k + 1 < cdf.len() && cdf[k].3 < u {
                     k += 1;
                 }
-                let (b, cos, _) = cdf[k];
+                let (b, cos, weight, _) = cdf[k];
                 let x = p.poly.sample(rng.next_f64(), rng.next_f64()) + n * (super::properties::RAY_OFFSET_REL * diag);
                 if super::properties::cast(&caster, x, dirs[b]).is_some() {
                     continue;
                 }
                 // Estimator: E·cos / (probability of the beam × rays).
-                let prob = cos * (field[b][0] + field[b][1] + field[b][2]) / total;
+                let prob = weight / total;
                 for c in 0..3 {
                     let e = field[b][c] * cos / (prob * f64::from(n_rays));
                     acc[c] += e;
@@ -669,13 +674,4 @@ pub fn relative_error(reference: &PolygonMeans, approx: &PolygonMeans) -> (f64, 
         area += w;
     }
     (worst / b_max, if area > 0.0 { acc / area / b_max } else { 0.0 })
-}
-
-/// Peak resident set size of this process in bytes (Linux `VmHWM`), when available.
-#[must_use]
-pub fn peak_rss_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }

@@ -46,11 +46,18 @@ impl ToneMap {
             .filter(|v| v.is_finite() && *v > 0.0)
             .collect();
         lum.sort_by(f64::total_cmp);
-        let white = if lum.is_empty() {
-            per_polygon_b.iter().map(|b| b[0].max(b[1]).max(b[2])).fold(0.0, f64::max)
-        } else {
-            lum[(lum.len() as f64 * 0.95) as usize].max(lum[lum.len() - 1] * 0.3) * 1.3
-        };
+        if lum.is_empty() {
+            let white = per_polygon_b.iter().map(|b| b[0].max(b[1]).max(b[2])).fold(0.0, f64::max);
+            return ToneMap { white: if white > 0.0 { white } else { 1.0 } };
+        }
+        ToneMap::from_levels(lum[(lum.len() as f64 * 0.95) as usize], lum[lum.len() - 1])
+    }
+
+    /// The white point from the 95th percentile and the largest of the non-emitting polygons'
+    /// radiosity (largest channel): 1.3 × the larger of the percentile and 0.3 × the largest.
+    #[must_use]
+    pub fn from_levels(p95: f64, max: f64) -> ToneMap {
+        let white = p95.max(0.3 * max) * 1.3;
         ToneMap { white: if white > 0.0 { white } else { 1.0 } }
     }
 
