@@ -207,25 +207,11 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         radiosity.clone_from(&sol.radiosity);
         solution = Some(sol);
     }
-    let mut solution = solution.expect("at least one pass solves");
-    let mut leaf_entries = 0;
-    if config.final_gather {
-        let t = Instant::now();
-        leaf_entries = solve::leaf_operator_entries(&h, &links);
-        if leaf_entries <= config.leaf_operator_max_entries {
-            progress(Progress::LeafSolve { entries: leaf_entries });
-            let sol = solve::solve_leaf(&h, &links, &solution.radiosity, &config.solve);
-            iterations += sol.iterations;
-            progress(Progress::Solved { pass: passes + 1, iterations: sol.iterations, residual: sol.residual });
-            solution = sol;
-        } else {
-            let (b, irr) = solve::final_gather(&h, &links, &solution.radiosity);
-            solution.radiosity = b;
-            solution.irradiance = irr;
-            leaf_entries = 0;
-        }
-        timings.solve += t.elapsed().as_secs_f64();
-    }
+    let solution = solution.expect("at least one pass solves");
+    let t = Instant::now();
+    let (solution, more_iterations, leaf_entries) = finish_solve(&h, &links, solution, config, progress, passes);
+    iterations += more_iterations;
+    timings.solve += t.elapsed().as_secs_f64();
     let error_estimate = config.estimate_error.then(|| solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
@@ -245,6 +231,47 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         iterations,
         timings,
     }
+}
+
+/// Solves the radiosity system of links already refined, with the emission now in `h` (a level of
+/// the instanced solver reuses one refinement for every instance of a prototype): the
+/// hierarchical solve, then the leaf-resolution solve or gather of [`Config::final_gather`].
+/// Returns the solution, the iterations and the leaf-operator entries (0 when gathered).
+#[must_use]
+pub fn solve_links(h: &Hierarchy, links: &[Link], config: &Config) -> (Solution, usize, usize) {
+    let sol = solve::solve(h, links, &initial_radiosity(h), &config.solve);
+    let iterations = sol.iterations;
+    let (sol, more, entries) = finish_solve(h, links, sol, config, &|_| {}, 1);
+    (sol, iterations + more, entries)
+}
+
+/// The final gather step after the hierarchical solve: `(solution, iterations, leaf entries)`.
+fn finish_solve(
+    h: &Hierarchy,
+    links: &[Link],
+    mut solution: Solution,
+    config: &Config,
+    progress: &dyn Fn(Progress),
+    passes: usize,
+) -> (Solution, usize, usize) {
+    let mut iterations = 0;
+    let mut leaf_entries = 0;
+    if config.final_gather {
+        leaf_entries = solve::leaf_operator_entries(h, links);
+        if leaf_entries <= config.leaf_operator_max_entries {
+            progress(Progress::LeafSolve { entries: leaf_entries });
+            let sol = solve::solve_leaf(h, links, &solution.radiosity, &config.solve);
+            iterations += sol.iterations;
+            progress(Progress::Solved { pass: passes + 1, iterations: sol.iterations, residual: sol.residual });
+            solution = sol;
+        } else {
+            let (b, irr) = solve::final_gather(h, links, &solution.radiosity);
+            solution.radiosity = b;
+            solution.irradiance = irr;
+            leaf_entries = 0;
+        }
+    }
+    (solution, iterations, leaf_entries)
 }
 
 /// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene

@@ -291,9 +291,7 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
     props
 }
 
-/// Smallest magnitude given to a ray direction's component: the BVH traversal divides by the
-/// components, and an exact zero can make it miss hits on faces aligned with the ray.
-pub const MIN_DIRECTION_COMPONENT: f64 = 1e-9;
+pub use crate::visibility::MIN_DIRECTION_COMPONENT;
 
 /// Closest hit along a ray, with no exactly-zero direction component.
 pub(super) fn cast(caster: &RayCaster, origin: DVec3, d: DVec3) -> Option<(f64, u32)> {

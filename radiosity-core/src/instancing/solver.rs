@@ -31,8 +31,10 @@ use super::properties::{CacheOutcome, PropertyCache, PropertyConfig, RadiativePr
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
 use crate::pipeline;
-use crate::refine::{BfHand, BfParams};
+use crate::refine::{BfHand, BfParams, Link};
 use crate::scene::{Material, SceneBuilder, shapes::box_faces};
+use crate::solve::Solution;
+use glam::{DMat3, DMat4};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
@@ -73,6 +75,10 @@ pub struct InstancedConfig {
     /// diagonal is opened in place: a closed instance receives the light as parallel beams, which
     /// misses how much brighter its near side is under a close light.
     pub open_near_emitter: f64,
+    /// Budget (approximate bytes) of the levels kept for reuse: a level lit from outside is
+    /// refined once and reused, solve only, for every later instance of its prototype that lies a
+    /// similarity away and whose light is no brighter (see [`solve_instanced`]). 0 disables reuse.
+    pub level_cache_bytes: usize,
 }
 
 impl Default for InstancedConfig {
@@ -88,6 +94,7 @@ impl Default for InstancedConfig {
             local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
             local_leaf_operator_max_entries: 250_000,
             open_near_emitter: 1.0,
+            level_cache_bytes: 16 << 20,
         }
     }
 }
@@ -111,6 +118,10 @@ pub struct InstancedStats {
     pub cache_hits: u64,
     /// Prototype properties computed.
     pub cache_computed: u64,
+    /// Local problems that reused the refinement of an earlier instance.
+    pub levels_reused: u64,
+    /// Most bytes (approximate) held by the level cache at once.
+    pub levels_cached_peak_bytes: u64,
     /// Wall-clock seconds.
     pub seconds: f64,
 }
@@ -138,7 +149,7 @@ pub struct PolygonInfo {
 }
 
 /// Receives finished polygons, in flattening order of each local problem (not globally sorted).
-pub trait RadiositySink {
+pub trait RadiositySink: Send {
     /// Polygon `info` finished, with its leaf elements.
     fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError>;
 }
@@ -216,6 +227,17 @@ pub fn solve_instanced(
     config: &InstancedConfig,
     sink: &mut dyn RadiositySink,
 ) -> Result<InstancedStats, InstancingError> {
+    // Run on a worker of the thread pool: the many small parallel loops of the local problems then
+    // start on this thread and are shared by work stealing, instead of each being handed to the
+    // pool and waited for (a futex round trip per loop, which dominated small levels).
+    rayon::scope(|_| solve_depth_first(scene, config, sink))
+}
+
+fn solve_depth_first(
+    scene: &InstancedScene,
+    config: &InstancedConfig,
+    sink: &mut dyn RadiositySink,
+) -> Result<InstancedStats, InstancingError> {
     let t0 = std::time::Instant::now();
     scene.validate()?;
     let counts = scene.flattened_counts(true);
@@ -225,17 +247,18 @@ pub fn solve_instanced(
     let mut proxies: HashMap<PrototypeId, Proxy> = HashMap::new();
     let mut stats = InstancedStats::default();
     let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, incoming: None }];
-    // The BF threshold is relative to the largest emission of the problem solved; a local problem's
-    // largest emission is often a wall's, far below the scene's lights, so its threshold is rescaled
-    // to stay relative to the scene's largest emission (the full solve's criterion).
+    // Every local BF threshold stays relative to the scene's largest emission (see `build_level`).
     let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
     let dirs = light_directions();
+    let mut levels = LevelCache::new(config.level_cache_bytes);
     while let Some(task) = stack.pop() {
         // Gather the level: own polygons of the task and of instances opened in place, and the
-        // closed instances.
+        // closed instances; `inlined` records which instances were opened in place (part of the
+        // key under which the level is cached).
         let mut own: Vec<(Poly, u32, u64, PrototypeId)> = Vec::new();
         let mut closed: Vec<(PrototypeId, Transform, u64)> = Vec::new();
         let mut emitters: Vec<Aabb> = Vec::new();
+        let mut inlined: Vec<bool> = Vec::new();
         let mut pending = vec![(task.prototype, task.transform, task.flat_base)];
         while let Some((pid, t, base)) = pending.pop() {
             let p = scene.prototype(pid);
@@ -255,10 +278,11 @@ pub fn solve_instanced(
             for inst in &p.instances {
                 let c = inst.prototype;
                 let child_t = t.then(&inst.transform);
-                if counts[c as usize] > config.max_closed_polygons
+                let open = counts[c as usize] > config.max_closed_polygons
                     || bounds[c as usize].is_empty()
-                    || near_an_emitter(&child_t.aabb(&bounds[c as usize]), &emitters, config.open_near_emitter)
-                {
+                    || near_an_emitter(&child_t.aabb(&bounds[c as usize]), &emitters, config.open_near_emitter);
+                inlined.push(open);
+                if open {
                     inline.push((c, child_t, k));
                 } else {
                     closed.push((c, child_t, k));
@@ -293,133 +317,99 @@ pub fn solve_instanced(
             let _ = proxies.insert(c, proxy_of(&bounds[c as usize], &props));
         }
 
-        // The local scene.
-        let mut b = SceneBuilder::new(&scene.path, &scene.prototype(task.prototype).name);
-        for m in &scene.materials {
-            let _ = b.material(m.clone())?;
-        }
-        let group = b.group("local");
-        let mut roles: Vec<Role> = Vec::new();
-        let add = |b: &mut SceneBuilder, roles: &mut Vec<Role>, poly: &Poly, material: u32, role: Role| -> Result<(), InstancingError> {
-            let before = b.n_polygons();
-            b.face(poly.vertices(), material, group, 0)?;
-            for _ in before..b.n_polygons() {
-                roles.push(role);
-            }
-            Ok(())
-        };
-        for &(poly, material, k, prototype) in &own {
-            add(&mut b, &mut roles, &poly, material, Role::Own(PolygonInfo { flat_index: k, material, prototype }))?;
-            if scene.materials[material as usize].two_sided {
-                add(&mut b, &mut roles, &reversed(&poly), material, Role::Own(PolygonInfo { flat_index: k + 1, material, prototype }))?;
-            }
-        }
-        let mut proxy_material: HashMap<PrototypeId, u32> = HashMap::new();
-        for (slot, &(c, t, _)) in closed.iter().enumerate() {
-            let proxy = proxies[&c];
-            let m = match proxy_material.get(&c) {
-                Some(&m) => m,
-                None => {
-                    let rho = proxy.albedo.map(|a| a.clamp(0.0, MAX_PROXY_REFLECTANCE));
-                    let m = b.material(Material::diffuse(&format!("(proxy {})", scene.prototype(c).name), rho))?;
-                    let _ = proxy_material.insert(c, m);
-                    m
-                }
-            };
-            for (_, quad) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false) {
-                let poly = t.poly(&Poly::quad(quad[0], quad[1], quad[2], quad[3]));
-                add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot })?;
-            }
-        }
-        let mut local = b.finish();
-        drop(own);
-        // The light that arrived at the instance, a field of parallel beams (one per direction bin),
-        // reaches each polygon by rays toward the beam that leave the level unblocked. Its first
-        // reflection becomes the polygon's emission; the local solve adds every further
-        // interreflection. Proxy faces keep their share per direction, for their own opening.
-        let is_proxy: Vec<bool> = roles.iter().map(|r| matches!(r, Role::ProxyFace { .. })).collect();
-        let (external, external_bins) = match &task.incoming {
-            Some(field) => incoming_irradiance(&local, &dirs, field, &is_proxy, config.incoming_rays, config.properties.seed),
-            None => (Vec::new(), Vec::new()),
-        };
-        if !external.is_empty() {
-            let mut materials = Vec::with_capacity(local.polygons.len());
-            for (i, p) in local.polygons.iter_mut().enumerate() {
-                let mut m = local.materials[p.material as usize].clone();
-                m.name = format!("p{i}");
-                m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * external[i][c]);
-                materials.push(m);
-                p.material = i as u32;
-            }
-            local.materials = materials;
-        }
-        let b_ref_local = local.polygons.iter().flat_map(|p| local.materials[p.material as usize].emission).fold(0.0, f64::max);
-        let mut bf = config.bf;
-        if b_ref_local > 0.0 && b_ref_scene > 0.0 {
-            bf.eps *= b_ref_scene / b_ref_local;
-        }
-        let oracle = BfHand { params: bf };
-        stats.max_local_polygons = stats.max_local_polygons.max(local.polygons.len());
-        if local.polygons.is_empty() {
-            continue;
-        }
-
-        // Solve, stream, keep only the proxies' irradiance.
+        // The level: reused from an earlier instance of the same prototype when one was refined
+        // for light at least as bright and lies in the same shape (a rigid motion and a uniform
+        // scale away), else built, refined and (below the top) cached.
         let t_local = std::time::Instant::now();
-        let local_config = pipeline::Config {
-            estimate_error: false,
-            solve: config.local_solve,
-            leaf_operator_max_entries: config.local_leaf_operator_max_entries,
-            ..config.pipeline
+        let key = (task.prototype, inlined);
+        let bound = task.incoming.as_ref().map(|field| irradiance_bound(&dirs, field));
+        let reused = bound.and_then(|bound| levels.find(&key, &task.transform.matrix, bound));
+        let mut fresh = None;
+        if reused.is_none() {
+            let light = task.incoming.as_deref().map(|field| (dirs.as_slice(), field));
+            let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, b_ref_scene, config)? else { continue };
+            fresh = Some(level);
+        }
+        drop(own);
+        let (level, similarity) = match (&mut fresh, reused) {
+            (Some(level), _) => (level, None),
+            (None, Some(similarity)) => (levels.get(&key), Some(similarity)),
+            (None, None) => unreachable!("a level is built when none is reused"),
         };
-        let solved = pipeline::run(&local, &oracle, &local_config, &|_| {});
+        stats.max_local_polygons = stats.max_local_polygons.max(level.polys.len());
+
+        // The light that arrived at the instance, a field of parallel beams (one per direction
+        // bin), reaches each polygon where the level's visibility table says it leaves the level
+        // unblocked. Its first reflection becomes the polygon's emission; the solve adds every
+        // further interreflection. Proxy faces keep their share per direction, for their own
+        // opening. Directions are taken into the level's own frame.
+        let rotation = similarity.as_ref().map_or(DMat3::IDENTITY, |s: &Similarity| s.rotation);
+        let dirs_level: Vec<DVec3> = dirs.iter().map(|d| rotation.transpose() * *d).collect();
+        let (external, external_bins) = match (&task.incoming, &level.table) {
+            (Some(field), Some(table)) => table_irradiance(&level.polys, table, &dirs_level, field, &level.is_proxy),
+            _ => (Vec::new(), Vec::new()),
+        };
+        let solution = match level.solution.take() {
+            Some(solution) => solution,
+            None => {
+                for (i, e) in level.h.emission.iter_mut().enumerate() {
+                    let ext = external.get(i).copied().unwrap_or([0.0; 3]);
+                    *e = std::array::from_fn(|c| level.base_emission[i][c] + level.h.reflectance[i][c] * ext[c]);
+                }
+                let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, &local_pipeline(config));
+                level.iterations = iterations;
+                solution
+            }
+        };
         if config.trace {
             eprintln!(
-                "local solve {}: `{}` {} polygons ({} proxies), {} elements, {} links, {} leaf-operator entries, {} iterations, {:.3}s, peak RSS {:.1} MB",
+                "local solve {}: `{}` {} polygons ({} proxies), {} elements, {} links, {} iterations, {}, {:.3}s, peak RSS {:.1} MB",
                 stats.local_solves + 1,
                 scene.prototype(task.prototype).name,
-                local.polygons.len(),
+                level.polys.len(),
                 closed.len(),
-                solved.hierarchy.len(),
-                solved.links.len(),
-                solved.leaf_entries,
-                solved.iterations,
+                level.h.len(),
+                level.links.len(),
+                level.iterations,
+                if similarity.is_some() { "reused" } else { "refined" },
                 t_local.elapsed().as_secs_f64(),
                 crate::output::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
             );
         }
         stats.local_solves += 1;
-        stats.links += solved.links.len() as u64;
-        stats.max_local_links = stats.max_local_links.max(solved.links.len() as u64);
-        let h = &solved.hierarchy;
+        stats.levels_reused += u64::from(similarity.is_some());
+        stats.links += level.links.len() as u64;
+        stats.max_local_links = stats.max_local_links.max(level.links.len() as u64);
+
+        // Stream the own polygons, keep only the proxies' irradiance.
+        let to_world = similarity.as_ref().map(|s| Transform { matrix: s.matrix });
+        let h = &level.h;
         let mut leaves = Vec::new();
-        // Per proxy face: its mean irradiance from this level's solve, and how the links that
-        // brought it split over directions.
         let mut face_irradiance: HashMap<usize, [f64; 3]> = HashMap::new();
-        for (i, role) in roles.iter().enumerate() {
+        for (i, role) in level.roles.iter().enumerate() {
             match *role {
                 Role::Own(info) => {
                     leaves.clear();
                     let ext = external.get(i).copied().unwrap_or([0.0; 3]);
                     collect_leaves(h, i as ElementId, &mut |e| {
                         if let Some(p) = h.get(e).poly() {
-                            let irr = solved.solution.irradiance[e as usize];
+                            let irr = solution.irradiance[e as usize];
                             leaves.push(Leaf {
-                                poly: *p,
-                                b: solved.solution.radiosity[e as usize],
+                                poly: to_world.as_ref().map_or(*p, |t| t.poly(p)),
+                                b: solution.radiosity[e as usize],
                                 h: std::array::from_fn(|c| irr[c] + ext[c]),
                             });
                         }
                     });
                     stats.leaves_out += leaves.len() as u64;
                     stats.polygons_out += 1;
-                    sink.polygon(&info, &leaves)?;
+                    sink.polygon(&PolygonInfo { flat_index: task.flat_base + info.flat_index, ..info }, &leaves)?;
                 }
                 Role::ProxyFace { .. } => {
                     let (mut acc, mut area) = ([0.0; 3], 0.0);
                     collect_leaves(h, i as ElementId, &mut |e| {
                         let a = h.get(e).area;
-                        let irr = solved.solution.irradiance[e as usize];
+                        let irr = solution.irradiance[e as usize];
                         for c in 0..3 {
                             acc[c] += a * irr[c];
                         }
@@ -429,17 +419,19 @@ pub fn solve_instanced(
                 }
             }
         }
-        let weights = link_directions(h, &solved.links, &solved.solution.radiosity, &is_proxy, &dirs);
+        // Per proxy face: how the links that brought its irradiance split over directions, plus
+        // its share of the beams from outside, as a field per closed instance.
+        let weights = link_directions(h, &level.links, &solution.radiosity, &level.is_proxy, &dirs_level);
         let mut fields = vec![vec![[0.0; 3]; dirs.len()]; closed.len()];
         let mut projected = vec![vec![0.0; dirs.len()]; closed.len()];
-        for (i, role) in roles.iter().enumerate() {
+        for (i, role) in level.roles.iter().enumerate() {
             let Role::ProxyFace { slot, .. } = *role else { continue };
-            let (area, n) = (local.polygons[i].poly.area(), local.polygons[i].poly.normal());
-            let along_normal = nearest_direction(&dirs, n);
+            let (area, n) = (level.polys[i].area(), level.polys[i].normal());
+            let along_normal = nearest_direction(&dirs_level, n);
             let h_local = face_irradiance.get(&i).copied().unwrap_or([0.0; 3]);
             let w = weights.get(&i);
             let total: [f64; 3] = std::array::from_fn(|c| w.map_or(0.0, |w| w.iter().map(|x| x[c]).sum()));
-            for (b, u) in dirs.iter().enumerate() {
+            for (b, u) in dirs_level.iter().enumerate() {
                 projected[slot][b] += area * n.dot(*u).max(0.0);
                 for c in 0..3 {
                     let ext = external_bins.get(i).and_then(|v| v.get(b)).map_or(0.0, |x| x[c]);
@@ -453,13 +445,19 @@ pub fn solve_instanced(
                 }
             }
         }
-        drop(solved);
+        drop(solution);
+        if let Some(level) = fresh
+            && let Some(bound) = bound
+        {
+            levels.insert(key, level, task.transform.matrix, bound);
+        }
         for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
             let field: Vec<[f64; 3]> =
                 fields[slot].iter().zip(&projected[slot]).map(|(flux, p)| flux.map(|f| if *p > 0.0 { f / p } else { 0.0 })).collect();
             stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(field) });
         }
     }
+    stats.levels_cached_peak_bytes = levels.peak_bytes as u64;
     stats.seconds = t0.elapsed().as_secs_f64();
     Ok(stats)
 }
@@ -542,65 +540,341 @@ fn link_directions(
     out
 }
 
-/// Irradiance from outside of every polygon of `local` (see the module docs): `field` is the
-/// irradiance perpendicular to each beam of `dirs`. Each polygon casts `rays` rays from jittered
-/// points toward beams drawn in proportion to what they would bring (`E·cos`, stratified), and
-/// receives a beam where its ray leaves the level unblocked: an unbiased estimate whose rays go
-/// where the light is. For polygons marked in `keep_bins`, the share of each beam is returned too.
-fn incoming_irradiance(
-    local: &crate::scene::Scene,
+/// A local problem: the level's polygons and proxy faces, refined, with what reusing it for
+/// another instance of the same prototype needs.
+struct Level {
+    /// The level's polygons, in the frame of the instance the level was built for.
+    polys: Vec<Poly>,
+    /// What each polygon stands for (flattened indices relative to the instance's first).
+    roles: Vec<Role>,
+    /// Proxy faces.
+    is_proxy: Vec<bool>,
+    /// Emission of each polygon, light from outside the level excluded.
+    base_emission: Vec<[f64; 3]>,
+    /// The refined hierarchy (its emission is rewritten for every instance).
+    h: Hierarchy,
+    /// The refined links.
+    links: Vec<Link>,
+    /// Visibility of the table's directions from each polygon (levels lit from outside).
+    table: Option<VisibilityTable>,
+    /// The solution of a level with no light from outside (the top), solved while refining.
+    solution: Option<Solution>,
+    /// Iterations of the last solve.
+    iterations: usize,
+}
+
+impl Level {
+    /// Approximate heap bytes held (what the level cache counts against its budget).
+    fn bytes(&self) -> usize {
+        use std::mem::size_of;
+        let h = &self.h;
+        self.polys.len() * (size_of::<Poly>() + size_of::<Role>() + 1 + 24)
+            + h.elements.len() * size_of::<crate::hierarchy::Element>()
+            + (h.children.len() + h.cluster_polygons.len()) * 4
+            + h.cluster_area_prefix.len() * 8
+            + (h.reflectance.len() + h.emission.len()) * 24
+            + self.links.len() * size_of::<Link>()
+            + self.table.as_ref().map_or(0, |t| t.counts.len())
+    }
+}
+
+/// Builds, refines and solves a level. With light from outside (`field`, in the directions
+/// `dirs`), the links are refined for this instance's light, whose first reflection is the
+/// polygons' emission. `None` when the level has no polygon.
+#[allow(clippy::too_many_arguments)]
+fn build_level(
+    scene: &InstancedScene,
+    task: &Task,
+    own: &[(Poly, u32, u64, PrototypeId)],
+    closed: &[(PrototypeId, Transform, u64)],
+    proxies: &HashMap<PrototypeId, Proxy>,
+    light: Option<(&[DVec3], &[[f64; 3]])>,
+    b_ref_scene: f64,
+    config: &InstancedConfig,
+) -> Result<Option<Level>, InstancingError> {
+    let mut b = SceneBuilder::new(&scene.path, &scene.prototype(task.prototype).name);
+    for m in &scene.materials {
+        let _ = b.material(m.clone())?;
+    }
+    let group = b.group("local");
+    let mut roles: Vec<Role> = Vec::new();
+    let add = |b: &mut SceneBuilder, roles: &mut Vec<Role>, poly: &Poly, material: u32, role: Role| -> Result<(), InstancingError> {
+        let before = b.n_polygons();
+        b.face(poly.vertices(), material, group, 0)?;
+        for _ in before..b.n_polygons() {
+            roles.push(role);
+        }
+        Ok(())
+    };
+    for &(poly, material, k, prototype) in own {
+        let k = k - task.flat_base;
+        add(&mut b, &mut roles, &poly, material, Role::Own(PolygonInfo { flat_index: k, material, prototype }))?;
+        if scene.materials[material as usize].two_sided {
+            add(&mut b, &mut roles, &reversed(&poly), material, Role::Own(PolygonInfo { flat_index: k + 1, material, prototype }))?;
+        }
+    }
+    let mut proxy_material: HashMap<PrototypeId, u32> = HashMap::new();
+    for (slot, &(c, t, _)) in closed.iter().enumerate() {
+        let proxy = proxies[&c];
+        let m = match proxy_material.get(&c) {
+            Some(&m) => m,
+            None => {
+                let rho = proxy.albedo.map(|a| a.clamp(0.0, MAX_PROXY_REFLECTANCE));
+                let m = b.material(Material::diffuse(&format!("(proxy {})", scene.prototype(c).name), rho))?;
+                let _ = proxy_material.insert(c, m);
+                m
+            }
+        };
+        for (_, quad) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false) {
+            let poly = t.poly(&Poly::quad(quad[0], quad[1], quad[2], quad[3]));
+            add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot })?;
+        }
+    }
+    let mut local = b.finish();
+    if local.polygons.is_empty() {
+        return Ok(None);
+    }
+    let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
+    let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
+    let mut table = None;
+    if let Some((dirs, field)) = light {
+        let caster = crate::visibility::RayCaster::new(&local);
+        let t = VisibilityTable::build(&polys, &caster, local.bounds().diagonal(), config.properties.seed);
+        let (external, _) = table_irradiance(&polys, &t, dirs, field, &[]);
+        table = Some(t);
+        let mut materials = Vec::with_capacity(local.polygons.len());
+        for (i, p) in local.polygons.iter_mut().enumerate() {
+            let mut m = local.materials[p.material as usize].clone();
+            m.name = format!("p{i}");
+            m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * external[i][c]);
+            materials.push(m);
+            p.material = i as u32;
+        }
+        local.materials = materials;
+    }
+    // The BF threshold is relative to the largest emission of the problem solved; a local problem's
+    // largest emission is often a wall's, far below the scene's lights, so its threshold is rescaled
+    // to stay relative to the scene's largest emission (the full solve's criterion).
+    let b_ref_local = local.polygons.iter().flat_map(|p| local.materials[p.material as usize].emission).fold(0.0, f64::max);
+    let mut bf = config.bf;
+    if b_ref_local > 0.0 && b_ref_scene > 0.0 {
+        bf.eps *= b_ref_scene / b_ref_local;
+    }
+    let solved = pipeline::run(&local, &BfHand { params: bf }, &local_pipeline(config), &|_| {});
+    Ok(Some(Level {
+        is_proxy: roles.iter().map(|r| matches!(r, Role::ProxyFace { .. })).collect(),
+        polys,
+        roles,
+        base_emission,
+        h: solved.hierarchy,
+        links: solved.links,
+        table,
+        solution: Some(solved.solution),
+        iterations: solved.iterations,
+    }))
+}
+
+/// Settings of every local solve.
+fn local_pipeline(config: &InstancedConfig) -> pipeline::Config {
+    pipeline::Config {
+        estimate_error: false,
+        solve: config.local_solve,
+        leaf_operator_max_entries: config.local_leaf_operator_max_entries,
+        ..config.pipeline
+    }
+}
+
+/// The brightest irradiance (per channel) that `field` brings to a surface facing any of `dirs`,
+/// ignoring blockers.
+fn irradiance_bound(dirs: &[DVec3], field: &[[f64; 3]]) -> [f64; 3] {
+    let mut best = [0.0f64; 3];
+    for n in dirs {
+        let mut e = [0.0; 3];
+        for (d, f) in dirs.iter().zip(field) {
+            let cos = n.dot(*d);
+            if cos > 0.0 {
+                for c in 0..3 {
+                    e[c] += f[c] * cos;
+                }
+            }
+        }
+        for c in 0..3 {
+            best[c] = best[c].max(e[c]);
+        }
+    }
+    best
+}
+
+/// Relative tolerance of [`similarity`]: how far from orthogonal the rotation part may be.
+pub const SIMILARITY_TOLERANCE: f64 = 1e-6;
+
+/// The motion from one instance's frame to another's, when it is a similarity.
+#[derive(Clone, Copy, Debug)]
+struct Similarity {
+    /// From the cached level's frame to the new instance's.
+    matrix: DMat4,
+    /// Its rotation.
+    rotation: DMat3,
+}
+
+/// The similarity (rotation, uniform scale, translation; no mirror) that takes frame `from` to
+/// frame `to`, if there is one: under it every form factor and visibility of a level is unchanged.
+fn similarity(from: &DMat4, to: &DMat4) -> Option<Similarity> {
+    let matrix = *to * from.inverse();
+    let linear = DMat3::from_mat4(matrix);
+    let det = linear.determinant();
+    if !(det.is_finite() && det > 0.0) {
+        return None;
+    }
+    let rotation = linear * det.cbrt().recip();
+    let off = rotation.transpose() * rotation - DMat3::IDENTITY;
+    let worst = off.to_cols_array().iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    (worst <= SIMILARITY_TOLERANCE).then_some(Similarity { matrix, rotation })
+}
+
+/// Levels kept for reuse, keyed by prototype and which of its instances were opened in place,
+/// within a budget of bytes (least recently used evicted first).
+struct LevelCache {
+    budget: usize,
+    entries: HashMap<(PrototypeId, Vec<bool>), CachedLevel>,
+    bytes: usize,
+    peak_bytes: usize,
+    clock: u64,
+}
+
+struct CachedLevel {
+    level: Level,
+    /// World transform of the instance the level was built for.
+    frame: DMat4,
+    /// The irradiance bound it was refined for.
+    refined_for: [f64; 3],
+    bytes: usize,
+    last_used: u64,
+}
+
+impl LevelCache {
+    fn new(budget: usize) -> LevelCache {
+        LevelCache { budget, entries: HashMap::new(), bytes: 0, peak_bytes: 0, clock: 0 }
+    }
+
+    /// A cached level usable for an instance at `frame` whose light is bounded by `bound`, as the
+    /// motion from the cached instance to this one.
+    fn find(&mut self, key: &(PrototypeId, Vec<bool>), frame: &DMat4, bound: [f64; 3]) -> Option<Similarity> {
+        let entry = self.entries.get_mut(key)?;
+        if (0..3).any(|c| bound[c] > entry.refined_for[c]) {
+            return None;
+        }
+        let s = similarity(&entry.frame, frame)?;
+        self.clock += 1;
+        entry.last_used = self.clock;
+        Some(s)
+    }
+
+    fn get(&mut self, key: &(PrototypeId, Vec<bool>)) -> &mut Level {
+        &mut self.entries.get_mut(key).expect("found before").level
+    }
+
+    /// Keeps `level` (replacing the entry of `key`) if it fits the budget, evicting the least
+    /// recently used levels as needed.
+    fn insert(&mut self, key: (PrototypeId, Vec<bool>), level: Level, frame: DMat4, refined_for: [f64; 3]) {
+        if let Some(old) = self.entries.remove(&key) {
+            self.bytes -= old.bytes;
+        }
+        let bytes = level.bytes();
+        if bytes > self.budget {
+            return;
+        }
+        while self.bytes + bytes > self.budget {
+            let Some(oldest) = self.entries.iter().min_by_key(|(_, e)| e.last_used).map(|(k, _)| k.clone()) else { break };
+            if let Some(e) = self.entries.remove(&oldest) {
+                self.bytes -= e.bytes;
+            }
+        }
+        self.clock += 1;
+        let _ = self.entries.insert(key, CachedLevel { level, frame, refined_for, bytes, last_used: self.clock });
+        self.bytes += bytes;
+        self.peak_bytes = self.peak_bytes.max(self.bytes);
+    }
+}
+
+/// Directions of a level's visibility table (a Fibonacci sphere in the level's frame).
+pub const TABLE_DIRECTIONS: u32 = 128;
+/// Rays per polygon and table direction, stratified over the polygon.
+pub const TABLE_RAYS: u32 = 4;
+
+/// For every polygon of a level and every table direction in front of it, how many of
+/// [`TABLE_RAYS`] rays leave the level unblocked: built once per level and used for every instance
+/// (a beam's direction is taken to the nearest table direction).
+struct VisibilityTable {
+    dirs: Vec<DVec3>,
+    /// `polygon × direction` counts.
+    counts: Vec<u8>,
+}
+
+impl VisibilityTable {
+    fn build(polys: &[Poly], caster: &crate::visibility::RayCaster, diag: f64, seed: u64) -> VisibilityTable {
+        use rayon::prelude::*;
+        let dirs = super::properties::sphere_directions(TABLE_DIRECTIONS);
+        let offset = super::properties::RAY_OFFSET_REL * diag.max(f64::MIN_POSITIVE);
+        let rows: Vec<Vec<u8>> = polys
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let n = p.normal();
+                let mut rng = crate::visibility::Rng::for_link(seed, i as u32, 0x7AB);
+                dirs.iter()
+                    .map(|d| {
+                        if n.dot(*d) <= 0.0 {
+                            return 0;
+                        }
+                        let mut clear = 0u8;
+                        for s in 0..TABLE_RAYS {
+                            let u = (f64::from(s) + rng.next_f64()) / f64::from(TABLE_RAYS);
+                            let x = p.sample(u, rng.next_f64()) + n * offset;
+                            clear += u8::from(caster.ray_clear(x, *d));
+                        }
+                        clear
+                    })
+                    .collect()
+            })
+            .collect();
+        VisibilityTable { dirs, counts: rows.concat() }
+    }
+}
+
+/// Irradiance from outside of every polygon of a level (see the module docs): `field` is the
+/// irradiance perpendicular to each beam of `dirs` (taken into the level's frame), received where
+/// the table says the beam's direction leaves the level. For polygons marked in `keep_bins`, the
+/// share of each beam is returned too.
+fn table_irradiance(
+    polys: &[Poly],
+    table: &VisibilityTable,
     dirs: &[DVec3],
     field: &[[f64; 3]],
     keep_bins: &[bool],
-    rays: u32,
-    seed: u64,
 ) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>) {
-    use rayon::prelude::*;
-    let caster = crate::visibility::RayCaster::new(local);
-    let diag = local.bounds().diagonal().max(f64::MIN_POSITIVE);
     let strongest = field.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max);
     let active: Vec<usize> =
         (0..dirs.len()).filter(|&b| field[b].iter().copied().fold(0.0, f64::max) > FIELD_REL_MIN * strongest).collect();
-    let n_rays = rays.max(1);
-    local
-        .polygons
-        .par_iter()
+    let nearest: Vec<usize> = dirs.iter().map(|d| nearest_direction(&table.dirs, *d)).collect();
+    let k = table.dirs.len();
+    polys
+        .iter()
         .enumerate()
         .map(|(i, p)| {
-            let n = p.poly.normal();
-            let mut rng = crate::visibility::Rng::for_link(seed, i as u32, 0x1C0);
+            let n = p.normal();
             let keep = keep_bins.get(i).copied().unwrap_or(false);
             let mut bins = if keep { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
-            // What each facing beam would bring unblocked, and the cumulative distribution.
-            let mut cdf: Vec<(usize, f64, f64, f64)> = Vec::with_capacity(active.len());
-            let mut total = 0.0;
+            let mut acc = [0.0; 3];
             for &b in &active {
                 let cos = n.dot(dirs[b]);
-                let weight = cos * (field[b][0] + field[b][1] + field[b][2]);
-                if cos > 0.0 && weight > 0.0 {
-                    total += weight;
-                    cdf.push((b, cos, weight, total));
-                }
-            }
-            let mut acc = [0.0; 3];
-            if total <= 0.0 {
-                return (acc, bins);
-            }
-            let mut k = 0;
-            for s in 0..n_rays {
-                let u = (f64::from(s) + rng.next_f64()) / f64::from(n_rays) * total;
-                while k + 1 < cdf.len() && cdf[k].3 < u {
-                    k += 1;
-                }
-                let (b, cos, weight, _) = cdf[k];
-                let x = p.poly.sample(rng.next_f64(), rng.next_f64()) + n * (super::properties::RAY_OFFSET_REL * diag);
-                if super::properties::cast(&caster, x, dirs[b]).is_some() {
+                let clear = table.counts[i * k + nearest[b]];
+                if cos <= 0.0 || clear == 0 {
                     continue;
                 }
-                // Estimator: E·cos / (probability of the beam × rays).
-                let prob = weight / total;
+                let v = f64::from(clear) / f64::from(TABLE_RAYS);
                 for c in 0..3 {
-                    let e = field[b][c] * cos / (prob * f64::from(n_rays));
+                    let e = field[b][c] * cos * v;
                     acc[c] += e;
                     if keep {
                         bins[b][c] += e;
@@ -639,12 +913,15 @@ fn collect_leaves(h: &Hierarchy, e: ElementId, f: &mut dyn FnMut(ElementId)) {
 pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(PolygonMeans, u64), InstancingError> {
     let flat = super::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
     // No error estimate: the comparison measures the error, and the instanced solve has none either.
-    let solved = pipeline::run(
-        &flat,
-        &BfHand { params: config.bf },
-        &pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline },
-        &|_| {},
-    );
+    // On a worker of the pool, as the instanced solve runs (a like-for-like comparison).
+    let solved = rayon::scope(|_| {
+        pipeline::run(
+            &flat,
+            &BfHand { params: config.bf },
+            &pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline },
+            &|_| {},
+        )
+    });
     let mut means = PolygonMeans::default();
     let mut leaves = Vec::new();
     for i in 0..flat.polygons.len() {

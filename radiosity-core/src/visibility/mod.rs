@@ -8,4 +8,4 @@
 mod rays;
 pub mod shaft;
 
-pub use rays::{KERNEL_REGULARISATION, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, sampled_visibility};
+pub use rays::{KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, sampled_visibility};

@@ -11,7 +11,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// them (a wall meeting the floor) do not occlude.
 pub const SEGMENT_END_EPS: f32 = 1e-5;
 
-/// How visibility is estimated.
+/// Smallest magnitude given to a ray direction's component: the BVH traversal divides by the
+/// components, and an exact zero can make it miss hits on faces aligned with the ray.
+pub const MIN_DIRECTION_COMPONENT: f64 = 1e-9;
+
 /// Regularisation of the kernel weights of visibility samples, relative to the squared sum of the
 /// two elements' radii (keeps one near-contact sample from dominating).
 pub const KERNEL_REGULARISATION: f64 = 1e-4;
@@ -150,6 +153,21 @@ impl RayCaster {
         } else {
             None
         }
+    }
+
+    /// True when the ray from `origin` along `dir` (scene coordinates) meets no triangle: an
+    /// occlusion query, cheaper than [`RayCaster::closest_hit`]. Direction components that are
+    /// exactly zero are nudged to a tiny value of the same sign (the traversal divides by them).
+    #[must_use]
+    pub fn ray_clear(&self, origin: DVec3, dir: DVec3) -> bool {
+        self.rays_cast.fetch_add(1, Ordering::Relaxed);
+        if self.triangles.is_empty() {
+            return true;
+        }
+        let d = dir.normalize_or_zero();
+        let nudge = |x: f64| if x.abs() < MIN_DIRECTION_COMPONENT { MIN_DIRECTION_COMPONENT.copysign(x) } else { x };
+        let ray = Ray::new(self.to_local(origin), Vec3A::new(nudge(d.x) as f32, nudge(d.y) as f32, nudge(d.z) as f32), 0.0, f32::INFINITY);
+        self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
     }
 
     /// Kernel-weighted visibility between `source` and `receiver` against every triangle of the
