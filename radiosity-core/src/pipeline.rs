@@ -235,13 +235,23 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
 
 /// Solves the radiosity system of links already refined, with the emission now in `h` (a level of
 /// the instanced solver reuses one refinement for every instance of a prototype): the
-/// hierarchical solve, then the leaf-resolution solve or gather of [`Config::final_gather`].
-/// Returns the solution, the iterations and the leaf-operator entries (0 when gathered).
+/// hierarchical solve, then the leaf-resolution solve or gather of [`Config::final_gather`]. The
+/// leaf-resolution coefficients are taken from `leaf` when given (computed before for the same
+/// hierarchy and links). Returns the solution, the iterations and the leaf-operator entries (0
+/// when gathered).
 #[must_use]
-pub fn solve_links(h: &Hierarchy, links: &[Link], config: &Config) -> (Solution, usize, usize) {
+pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: Option<&solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
     let sol = solve::solve(h, links, &initial_radiosity(h), &config.solve);
     let iterations = sol.iterations;
-    let (sol, more, entries) = finish_solve(h, links, sol, config, &|_| {}, 1);
+    let (sol, more, entries) = match leaf {
+        Some(coefficients) if config.final_gather => {
+            let op = solve::LeafOperator::with_coefficients(h, links, coefficients);
+            let sol = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
+            let more = sol.iterations;
+            (sol, more, coefficients.entries())
+        }
+        _ => finish_solve(h, links, sol, config, &|_| {}, 1),
+    };
     (sol, iterations + more, entries)
 }
 

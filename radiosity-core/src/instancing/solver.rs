@@ -317,16 +317,16 @@ fn solve_depth_first(
             let _ = proxies.insert(c, proxy_of(&bounds[c as usize], &props));
         }
 
-        // The level: reused from an earlier instance of the same prototype when one was refined
-        // for light at least as bright and lies in the same shape (a rigid motion and a uniform
-        // scale away), else built, refined and (below the top) cached.
+        // The level: reused from an earlier instance of the same prototype whose light was of the
+        // same brightness class and which lies a similarity (rigid motion and uniform scale)
+        // away, else built, refined and (below the top) cached.
         let t_local = std::time::Instant::now();
-        let key = (task.prototype, inlined);
-        let bound = task.incoming.as_ref().map(|field| irradiance_bound(&dirs, field));
-        let reused = bound.and_then(|bound| levels.find(&key, &task.transform.matrix, bound));
+        let class = task.incoming.as_ref().map(|field| brightness_class(irradiance_bound(&dirs, field)));
+        let key = (task.prototype, inlined, class.map_or(i32::MIN, |c| c.0));
+        let reused = if class.is_some() { levels.find(&key, &task.transform.matrix) } else { None };
         let mut fresh = None;
         if reused.is_none() {
-            let light = task.incoming.as_deref().map(|field| (dirs.as_slice(), field));
+            let light = task.incoming.as_deref().zip(class).map(|(field, (_, raise))| (dirs.as_slice(), field, raise));
             let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, b_ref_scene, config)? else { continue };
             fresh = Some(level);
         }
@@ -356,7 +356,14 @@ fn solve_depth_first(
                     let ext = external.get(i).copied().unwrap_or([0.0; 3]);
                     *e = std::array::from_fn(|c| level.base_emission[i][c] + level.h.reflectance[i][c] * ext[c]);
                 }
-                let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, &local_pipeline(config));
+                let pipeline_config = local_pipeline(config);
+                if level.leaf.is_none()
+                    && pipeline_config.final_gather
+                    && crate::solve::leaf_operator_entries(&level.h, &level.links) <= pipeline_config.leaf_operator_max_entries
+                {
+                    level.leaf = Some(crate::solve::LeafCoefficients::new(&level.h, &level.links));
+                }
+                let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, level.leaf.as_ref(), &pipeline_config);
                 level.iterations = iterations;
                 solution
             }
@@ -447,9 +454,9 @@ fn solve_depth_first(
         }
         drop(solution);
         if let Some(level) = fresh
-            && let Some(bound) = bound
+            && class.is_some()
         {
-            levels.insert(key, level, task.transform.matrix, bound);
+            levels.insert(key, level, task.transform.matrix);
         }
         for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
             let field: Vec<[f64; 3]> =
@@ -557,6 +564,8 @@ struct Level {
     links: Vec<Link>,
     /// Visibility of the table's directions from each polygon (levels lit from outside).
     table: Option<VisibilityTable>,
+    /// Leaf-resolution coefficients, computed at the first solve of a level lit from outside.
+    leaf: Option<crate::solve::LeafCoefficients>,
     /// The solution of a level with no light from outside (the top), solved while refining.
     solution: Option<Solution>,
     /// Iterations of the last solve.
@@ -575,12 +584,14 @@ impl Level {
             + (h.reflectance.len() + h.emission.len()) * 24
             + self.links.len() * size_of::<Link>()
             + self.table.as_ref().map_or(0, |t| t.counts.len())
+            + self.leaf.as_ref().map_or(0, crate::solve::LeafCoefficients::bytes)
     }
 }
 
-/// Builds, refines and solves a level. With light from outside (`field`, in the directions
-/// `dirs`), the links are refined for this instance's light, whose first reflection is the
-/// polygons' emission. `None` when the level has no polygon.
+/// Builds and refines a level, and solves it when it has no light from outside (the top). With
+/// light from outside (`field` in the directions `dirs`, and the factor that raises it to the top
+/// of its [`brightness_class`]), the links are refined for the raised light, whose first reflection
+/// is the polygons' emission. `None` when the level has no polygon.
 #[allow(clippy::too_many_arguments)]
 fn build_level(
     scene: &InstancedScene,
@@ -588,7 +599,7 @@ fn build_level(
     own: &[(Poly, u32, u64, PrototypeId)],
     closed: &[(PrototypeId, Transform, u64)],
     proxies: &HashMap<PrototypeId, Proxy>,
-    light: Option<(&[DVec3], &[[f64; 3]])>,
+    light: Option<(&[DVec3], &[[f64; 3]], f64)>,
     b_ref_scene: f64,
     config: &InstancedConfig,
 ) -> Result<Option<Level>, InstancingError> {
@@ -637,7 +648,7 @@ fn build_level(
     let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
     let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
     let mut table = None;
-    if let Some((dirs, field)) = light {
+    if let Some((dirs, field, raise)) = light {
         let caster = crate::visibility::RayCaster::new(&local);
         let t = VisibilityTable::build(&polys, &caster, local.bounds().diagonal(), config.properties.seed);
         let (external, _) = table_irradiance(&polys, &t, dirs, field, &[]);
@@ -646,7 +657,7 @@ fn build_level(
         for (i, p) in local.polygons.iter_mut().enumerate() {
             let mut m = local.materials[p.material as usize].clone();
             m.name = format!("p{i}");
-            m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * external[i][c]);
+            m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * raise * external[i][c]);
             materials.push(m);
             p.material = i as u32;
         }
@@ -669,7 +680,9 @@ fn build_level(
         h: solved.hierarchy,
         links: solved.links,
         table,
-        solution: Some(solved.solution),
+        leaf: None,
+        // Lit from outside, the level was refined for raised light: it is solved for its own below.
+        solution: light.is_none().then_some(solved.solution),
         iterations: solved.iterations,
     }))
 }
@@ -705,6 +718,24 @@ fn irradiance_bound(dirs: &[DVec3], field: &[[f64; 3]]) -> [f64; 3] {
     best
 }
 
+/// The brightness class of a level's light: `⌈log₂ m⌉` of the largest channel `m` of its
+/// [`irradiance_bound`], and the factor (in [1, 2)) that raises the light to the class's top. A level
+/// is refined for its light raised to the top of its class, so that its refinement serves every
+/// instance of the class (the BF criterion never asks for less refinement under brighter light),
+/// and instances under much dimmer light get their own, coarser level.
+fn brightness_class(bound: [f64; 3]) -> (i32, f64) {
+    let m = bound.into_iter().fold(0.0, f64::max);
+    if !(m > 0.0 && m.is_finite()) {
+        return (i32::MIN, 1.0);
+    }
+    let class = m.log2().ceil() as i32;
+    (class, 2f64.powi(class) / m)
+}
+
+/// What a cached level is found by: its prototype, which of its instances were opened in place,
+/// and the brightness class of its light.
+type LevelKey = (PrototypeId, Vec<bool>, i32);
+
 /// Relative tolerance of [`similarity`]: how far from orthogonal the rotation part may be.
 pub const SIMILARITY_TOLERANCE: f64 = 1e-6;
 
@@ -736,7 +767,7 @@ fn similarity(from: &DMat4, to: &DMat4) -> Option<Similarity> {
 /// within a budget of bytes (least recently used evicted first).
 struct LevelCache {
     budget: usize,
-    entries: HashMap<(PrototypeId, Vec<bool>), CachedLevel>,
+    entries: HashMap<LevelKey, CachedLevel>,
     bytes: usize,
     peak_bytes: usize,
     clock: u64,
@@ -746,8 +777,6 @@ struct CachedLevel {
     level: Level,
     /// World transform of the instance the level was built for.
     frame: DMat4,
-    /// The irradiance bound it was refined for.
-    refined_for: [f64; 3],
     bytes: usize,
     last_used: u64,
 }
@@ -757,26 +786,23 @@ impl LevelCache {
         LevelCache { budget, entries: HashMap::new(), bytes: 0, peak_bytes: 0, clock: 0 }
     }
 
-    /// A cached level usable for an instance at `frame` whose light is bounded by `bound`, as the
+    /// A cached level usable for an instance at `frame`, as the
     /// motion from the cached instance to this one.
-    fn find(&mut self, key: &(PrototypeId, Vec<bool>), frame: &DMat4, bound: [f64; 3]) -> Option<Similarity> {
+    fn find(&mut self, key: &LevelKey, frame: &DMat4) -> Option<Similarity> {
         let entry = self.entries.get_mut(key)?;
-        if (0..3).any(|c| bound[c] > entry.refined_for[c]) {
-            return None;
-        }
         let s = similarity(&entry.frame, frame)?;
         self.clock += 1;
         entry.last_used = self.clock;
         Some(s)
     }
 
-    fn get(&mut self, key: &(PrototypeId, Vec<bool>)) -> &mut Level {
+    fn get(&mut self, key: &LevelKey) -> &mut Level {
         &mut self.entries.get_mut(key).expect("found before").level
     }
 
     /// Keeps `level` (replacing the entry of `key`) if it fits the budget, evicting the least
     /// recently used levels as needed.
-    fn insert(&mut self, key: (PrototypeId, Vec<bool>), level: Level, frame: DMat4, refined_for: [f64; 3]) {
+    fn insert(&mut self, key: LevelKey, level: Level, frame: DMat4) {
         if let Some(old) = self.entries.remove(&key) {
             self.bytes -= old.bytes;
         }
@@ -791,7 +817,7 @@ impl LevelCache {
             }
         }
         self.clock += 1;
-        let _ = self.entries.insert(key, CachedLevel { level, frame, refined_for, bytes, last_used: self.clock });
+        let _ = self.entries.insert(key, CachedLevel { level, frame, bytes, last_used: self.clock });
         self.bytes += bytes;
         self.peak_bytes = self.peak_bytes.max(self.bytes);
     }

@@ -23,10 +23,65 @@ pub const LEAF_OPERATOR_MAX_ENTRIES: usize = 40_000_000;
 /// Per-leaf gather lists over the chain of ancestor links.
 pub struct LeafOperator<'a> {
     op: Operator<'a>,
-    /// Start of each leaf's entries in `src`/`coef` (length leaves + 1).
+    lists: std::borrow::Cow<'a, LeafCoefficients>,
+}
+
+/// The coefficients of a [`LeafOperator`]: geometry only (form factors and visibility), so they
+/// serve every emission of the same hierarchy and links (the instanced solver keeps them with a
+/// level it reuses).
+#[derive(Clone, Debug)]
+pub struct LeafCoefficients {
+    /// Start of each leaf's entries in `src`/`coef` (length leaves + 1), leaves in
+    /// [`Operator`] order.
     start: Vec<usize>,
     src: Vec<ElementId>,
     coef: Vec<f64>,
+}
+
+impl LeafCoefficients {
+    /// Evaluates `link_form_factor(source, leaf)` for every leaf and every link on its chain.
+    #[must_use]
+    pub fn new(h: &Hierarchy, links: &[Link]) -> LeafCoefficients {
+        let index = LinksByReceiver::new(h, links);
+        let lists: Vec<Vec<(ElementId, f64)>> = Operator::new(h, links)
+            .leaves()
+            .par_iter()
+            .map(|&leaf| {
+                let mut list = Vec::new();
+                index.leaf_chain(h, leaf, |source, c| {
+                    if c > 0.0 {
+                        list.push((source, c));
+                    }
+                });
+                list
+            })
+            .collect();
+        let mut start = Vec::with_capacity(lists.len() + 1);
+        let total: usize = lists.iter().map(Vec::len).sum();
+        let mut src = Vec::with_capacity(total);
+        let mut coef = Vec::with_capacity(total);
+        start.push(0);
+        for list in lists {
+            for (s, c) in list {
+                src.push(s);
+                coef.push(c);
+            }
+            start.push(src.len());
+        }
+        LeafCoefficients { start, src, coef }
+    }
+
+    /// Stored coefficients.
+    #[must_use]
+    pub fn entries(&self) -> usize {
+        self.coef.len()
+    }
+
+    /// Heap bytes held.
+    #[must_use]
+    pub fn bytes(&self) -> usize {
+        self.start.len() * size_of::<usize>() + self.src.len() * size_of::<ElementId>() + self.coef.len() * size_of::<f64>()
+    }
 }
 
 /// Number of (leaf, chain link) coefficients the leaf operator would store.
@@ -96,34 +151,14 @@ impl<'a> LeafOperator<'a> {
     /// Builds the per-leaf lists, evaluating `link_form_factor(source, leaf)` for ancestor links.
     #[must_use]
     pub fn new(h: &'a Hierarchy, links: &[Link]) -> LeafOperator<'a> {
-        let op = Operator::new(h, links);
-        let index = LinksByReceiver::new(h, links);
-        let lists: Vec<Vec<(ElementId, f64)>> = op
-            .leaves()
-            .par_iter()
-            .map(|&leaf| {
-                let mut list = Vec::new();
-                index.leaf_chain(h, leaf, |source, c| {
-                    if c > 0.0 {
-                        list.push((source, c));
-                    }
-                });
-                list
-            })
-            .collect();
-        let mut start = Vec::with_capacity(lists.len() + 1);
-        let total: usize = lists.iter().map(Vec::len).sum();
-        let mut src = Vec::with_capacity(total);
-        let mut coef = Vec::with_capacity(total);
-        start.push(0);
-        for list in lists {
-            for (s, c) in list {
-                src.push(s);
-                coef.push(c);
-            }
-            start.push(src.len());
-        }
-        LeafOperator { op, start, src, coef }
+        LeafOperator { op: Operator::new(h, links), lists: std::borrow::Cow::Owned(LeafCoefficients::new(h, links)) }
+    }
+
+    /// The operator of `h` and `links` with coefficients computed before by
+    /// [`LeafCoefficients::new`] for the same hierarchy and links (the emission may differ).
+    #[must_use]
+    pub fn with_coefficients(h: &'a Hierarchy, links: &[Link], coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
+        LeafOperator { op: Operator::new(h, links), lists: std::borrow::Cow::Borrowed(coefficients) }
     }
 
     /// The hierarchical operator underneath (leaf order, pull, emission).
@@ -135,20 +170,21 @@ impl<'a> LeafOperator<'a> {
     /// Stored coefficients.
     #[must_use]
     pub fn entries(&self) -> usize {
-        self.coef.len()
+        self.lists.entries()
     }
 
     /// Irradiance of every leaf (in leaf order) for leaf radiosity `x`.
     #[must_use]
     pub fn gather_leaves(&self, x: &[f64]) -> Vec<[f64; 3]> {
         let b = self.op.pull(x);
+        let l = &*self.lists;
         (0..self.op.leaves().len())
             .into_par_iter()
             .map(|i| {
                 let mut acc = [0.0; 3];
-                for k in self.start[i]..self.start[i + 1] {
-                    let bs = b[self.src[k] as usize];
-                    let c = self.coef[k];
+                for k in l.start[i]..l.start[i + 1] {
+                    let bs = b[l.src[k] as usize];
+                    let c = l.coef[k];
                     acc[0] += c * bs[0];
                     acc[1] += c * bs[1];
                     acc[2] += c * bs[2];

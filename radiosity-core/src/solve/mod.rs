@@ -13,7 +13,7 @@ mod operator;
 pub use estimate::{ESTIMATE_BUDGET, ESTIMATE_MAX_SAMPLES, error_estimate};
 pub use final_gather::final_gather;
 pub use gmres::{GmresResult, gmres};
-pub use leaf::{LEAF_OPERATOR_MAX_ENTRIES, LeafOperator, leaf_operator_entries};
+pub use leaf::{LEAF_OPERATOR_MAX_ENTRIES, LeafCoefficients, LeafOperator, leaf_operator_entries};
 pub use operator::Operator;
 
 use crate::hierarchy::Hierarchy;
@@ -66,7 +66,12 @@ pub fn solve(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &Solve
 /// the hierarchical solution).
 #[must_use]
 pub fn solve_leaf(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &SolveConfig) -> Solution {
-    let op = LeafOperator::new(h, links);
+    solve_leaf_operator(&LeafOperator::new(h, links), initial, config)
+}
+
+/// Solves the system of a leaf operator built before (see [`LeafOperator::with_coefficients`]).
+#[must_use]
+pub fn solve_leaf_operator(op: &LeafOperator<'_>, initial: &[[f64; 3]], config: &SolveConfig) -> Solution {
     let rhs = op.hierarchical().emission();
     let x0 = op.hierarchical().leaves_from_elements(initial);
     let result = gmres(&|x: &[f64], y: &mut [f64]| op.apply_system(x, y), &rhs, x0, config);
