@@ -10,19 +10,30 @@
 //!   holding it) are sorted by the direction toward their source into [`LIGHT_DIRECTIONS`] bins, and
 //!   each face's irradiance is split over the bins in those proportions; the flux per bin over the
 //!   proxy's projected area in that direction is a field of parallel beams (a distant-light
-//!   model). Every polygon of the opened level gathers the beams by [`InstancedConfig::incoming_rays`]
-//!   rays, drawn toward the beams in proportion to what they bring, that leave the level unblocked,
-//!   and reflects the result once as its emission. The local problem is then refined and solved with
-//!   that outside held fixed (its root self-link is the local interreflection), its own polygons are
-//!   streamed to the sink, and its hierarchy is dropped before its sub-instances are opened in turn;
-//!   the beams that reach a sub-instance's proxy are passed on to it bin by bin.
+//!   model). Every polygon of the opened level gathers the beams where its level's visibility
+//!   table ([`TABLE_DIRECTIONS`] directions × [`TABLE_RAYS`] rays per polygon, cast once per level)
+//!   says the beam's direction leaves the level unblocked, and reflects the result once as its
+//!   emission. The local problem is then refined and solved with that outside held fixed (its root
+//!   self-link is the local interreflection), its own polygons are streamed to the sink, and its
+//!   hierarchy is dropped (or cached, below) before its sub-instances are opened in turn; the beams
+//!   that reach a sub-instance's proxy are passed on to it bin by bin.
+//!
+//! Reuse: the refinement of a level (hierarchy, links, leaf-resolution coefficients, visibility
+//! table) depends on its geometry and, through the BF criterion, on how bright its light is; it is
+//! kept, within [`InstancedConfig::level_cache_bytes`], for the later instances of the same
+//! prototype that lie a similarity away (rotation, uniform scale, translation) and whose light is
+//! of the same brightness class (`brightness_class`: a factor of two); the level is refined for the top of its
+//! class, and each such instance only solves the linear system for its own light. Form factors and
+//! visibility are invariant under a similarity, so a reused level is the level that would be
+//! refined for the class's top light, exactly; beams are turned into the level's frame.
 //!
 //! Instances whose flattened polygon count exceeds [`InstancedConfig::max_closed_polygons`] are
 //! opened in place (their content joins the current level): the policy that keeps property
 //! computation and every local problem bounded. So are instances nearer to an emitter of their level
 //! than [`InstancedConfig::open_near_emitter`] times their size, where parallel beams would miss
-//! how much brighter their near side is. Memory is bounded by the largest local problem plus one
-//! field ([`LIGHT_DIRECTIONS`] RGB values) per pending instance; the flattened scene is never built.
+//! how much brighter their near side is. Memory is bounded by the largest local problem, plus the
+//! level cache's budget, plus one field ([`LIGHT_DIRECTIONS`] RGB values) per pending instance; the
+//! flattened scene is never built.
 
 use super::InstancingError;
 use super::flatten::{FlattenOptions, reversed};
@@ -57,9 +68,6 @@ pub struct InstancedConfig {
     pub cache_dir: Option<PathBuf>,
     /// Instances of prototypes with more flattened polygons than this are opened in place.
     pub max_closed_polygons: u64,
-    /// Rays per polygon gathering the light that arrived at an opened instance (rounded up to a
-    /// square number of strata).
-    pub incoming_rays: u32,
     /// Print one line per local solve to standard error.
     pub trace: bool,
     /// Linear solver of every local solve (and of [`solve_full`], for a like-for-like comparison):
@@ -89,7 +97,6 @@ impl Default for InstancedConfig {
             properties: PropertyConfig::default(),
             cache_dir: None,
             max_closed_polygons: 20_000,
-            incoming_rays: 64,
             trace: false,
             local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
             local_leaf_operator_max_entries: 250_000,
@@ -392,7 +399,7 @@ fn solve_depth_first(
         let to_world = similarity.as_ref().map(|s| Transform { matrix: s.matrix });
         let h = &level.h;
         let mut leaves = Vec::new();
-        let mut face_irradiance: HashMap<usize, [f64; 3]> = HashMap::new();
+        let mut face_irradiance = vec![[0.0; 3]; level.polys.len()];
         for (i, role) in level.roles.iter().enumerate() {
             match *role {
                 Role::Own(info) => {
@@ -422,36 +429,45 @@ fn solve_depth_first(
                         }
                         area += a;
                     });
-                    let _ = face_irradiance.insert(i, acc.map(|v| if area > 0.0 { v / area } else { 0.0 }));
+                    face_irradiance[i] = acc.map(|v| if area > 0.0 { v / area } else { 0.0 });
                 }
             }
         }
         // Per proxy face: how the links that brought its irradiance split over directions, plus
-        // its share of the beams from outside, as a field per closed instance.
-        let weights = link_directions(h, &level.links, &solution.radiosity, &level.is_proxy, &dirs_level);
+        // its share of the beams from outside, as a field per closed instance. Two passes over the
+        // links (per-face totals, then shares), so that no per-face field is ever held.
+        let mut face_total = vec![[0.0; 3]; level.polys.len()];
+        for_each_link_direction(h, &level.links, &solution.radiosity, &level.is_proxy, &dirs_level, |face, _, w| {
+            for c in 0..3 {
+                face_total[face][c] += w[c];
+            }
+        });
         let mut fields = vec![vec![[0.0; 3]; dirs.len()]; closed.len()];
         let mut projected = vec![vec![0.0; dirs.len()]; closed.len()];
         for (i, role) in level.roles.iter().enumerate() {
             let Role::ProxyFace { slot, .. } = *role else { continue };
             let (area, n) = (level.polys[i].area(), level.polys[i].normal());
             let along_normal = nearest_direction(&dirs_level, n);
-            let h_local = face_irradiance.get(&i).copied().unwrap_or([0.0; 3]);
-            let w = weights.get(&i);
-            let total: [f64; 3] = std::array::from_fn(|c| w.map_or(0.0, |w| w.iter().map(|x| x[c]).sum()));
+            let h_local = face_irradiance[i];
             for (b, u) in dirs_level.iter().enumerate() {
                 projected[slot][b] += area * n.dot(*u).max(0.0);
                 for c in 0..3 {
                     let ext = external_bins.get(i).and_then(|v| v.get(b)).map_or(0.0, |x| x[c]);
-                    let local_share = match w {
-                        Some(w) if total[c] > 0.0 => h_local[c] * w[b][c] / total[c],
-                        // No link to attribute (none arrived, or all from behind): along the normal.
-                        _ if b == along_normal => h_local[c],
-                        _ => 0.0,
-                    };
-                    fields[slot][b][c] += area * (ext + local_share);
+                    // No link to attribute (none arrived, or all from behind): along the normal.
+                    let unattributed = if face_total[i][c] <= 0.0 && b == along_normal { h_local[c] } else { 0.0 };
+                    fields[slot][b][c] += area * (ext + unattributed);
                 }
             }
         }
+        for_each_link_direction(h, &level.links, &solution.radiosity, &level.is_proxy, &dirs_level, |face, b, w| {
+            let Role::ProxyFace { slot } = level.roles[face] else { return };
+            let area = level.polys[face].area();
+            for c in 0..3 {
+                if face_total[face][c] > 0.0 {
+                    fields[slot][b][c] += area * face_irradiance[face][c] * w[c] / face_total[face][c];
+                }
+            }
+        });
         drop(solution);
         if let Some(level) = fresh
             && class.is_some()
@@ -459,8 +475,10 @@ fn solve_depth_first(
             levels.insert(key, level, task.transform.matrix);
         }
         for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
-            let field: Vec<[f64; 3]> =
-                fields[slot].iter().zip(&projected[slot]).map(|(flux, p)| flux.map(|f| if *p > 0.0 { f / p } else { 0.0 })).collect();
+            let mut field = std::mem::take(&mut fields[slot]);
+            for (flux, p) in field.iter_mut().zip(&projected[slot]) {
+                *flux = flux.map(|f| if *p > 0.0 { f / p } else { 0.0 });
+            }
             stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(field) });
         }
     }
@@ -500,24 +518,17 @@ fn nearest_direction(dirs: &[DVec3], u: DVec3) -> usize {
     best.0
 }
 
-/// For every proxy face, how the links that arrived at it (at the face or below, or at a cluster
-/// holding it) split over the direction bins: `F·V·B_source` (RGB) by the bin of the direction
-/// toward the source (for a cluster receiver, weighted by the face's cosine toward it).
-fn link_directions(
+/// Calls `f(face, bin, F·V·B_source)` (RGB) for every link that arrived at a proxy face (at the
+/// face or below, or at a cluster holding it), with the bin of the direction toward its source (for
+/// a cluster receiver, weighted by the face's cosine toward it).
+fn for_each_link_direction(
     h: &Hierarchy,
     links: &[crate::refine::Link],
     radiosity: &[[f64; 3]],
     is_proxy: &[bool],
     dirs: &[DVec3],
-) -> HashMap<usize, Vec<[f64; 3]>> {
-    let mut out: HashMap<usize, Vec<[f64; 3]>> = HashMap::new();
-    let mut add = |face: usize, u: DVec3, w: [f64; 3]| {
-        let bins = out.entry(face).or_insert_with(|| vec![[0.0; 3]; dirs.len()]);
-        let b = nearest_direction(dirs, u);
-        for c in 0..3 {
-            bins[b][c] += w[c];
-        }
-    };
+    mut f: impl FnMut(usize, usize, [f64; 3]),
+) {
     for l in links {
         let (r, src) = (h.get(l.receiver), h.get(l.source));
         let b_src = radiosity[l.source as usize];
@@ -531,7 +542,7 @@ fn link_directions(
                     let u = (src.center - face.center).normalize_or_zero();
                     let cos = face.normal.dot(u);
                     if cos > 0.0 {
-                        add(p as usize, u, b_src.map(|x| l.ff * l.vis * x * cos));
+                        f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x * cos));
                     }
                 }
             }
@@ -539,12 +550,11 @@ fn link_directions(
                 let Some(p) = r.polygon() else { continue };
                 if is_proxy.get(p as usize).copied().unwrap_or(false) {
                     let u = (src.center - r.center).normalize_or_zero();
-                    add(p as usize, u, b_src.map(|x| l.ff * l.vis * x));
+                    f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x));
                 }
             }
         }
     }
-    out
 }
 
 /// A local problem: the level's polygons and proxy faces, refined, with what reusing it for
