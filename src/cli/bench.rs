@@ -30,11 +30,12 @@ pub enum BenchCommand {
 #[derive(clap::Args, Debug)]
 pub struct ShaftBenchArgs {
     /// Scenes (files or generated names); default: cornell and the generated duplex, sj-geometry,
-    /// sj-shadow and stairs scenes.
+    /// sj-shadow, stairs and rotated scenes.
     pub scenes: Vec<String>,
     #[command(flatten)]
     pub options: SolveOptions,
-    /// Solves per method and scene, interleaved (rays, aabb, obb, rays, ...); the fastest counts.
+    /// Solves per method and scene, interleaved (rays, aabb, obb, aabb/shaft, obb/shaft, rays, ...);
+    /// the fastest counts.
     #[arg(long, default_value_t = 3)]
     pub repeats: u32,
     /// Print one JSON document instead of the table.
@@ -146,7 +147,7 @@ fn bench_solve(args: &SolveBenchArgs) -> anyhow::Result<()> {
         print_header();
     }
     for (i, scene) in scenes.iter().enumerate() {
-        let stats = child_solve(&exe, scene, &args.options, None, &tmp.join(format!("{i}")))?;
+        let stats = child_solve(&exe, scene, &args.options, None, None, &tmp.join(format!("{i}")))?;
         if !args.json {
             print_row(scene, &stats);
         }
@@ -276,6 +277,7 @@ fn child_solve(
     scene: &str,
     o: &SolveOptions,
     visibility: Option<&str>,
+    oracle: Option<&str>,
     out: &std::path::Path,
 ) -> anyhow::Result<serde_json::Value> {
     let mut cmd = Command::new(exe);
@@ -297,6 +299,9 @@ fn child_solve(
     ]);
     if let Some(v) = visibility {
         cmd.args(["--visibility", v]);
+    }
+    if let Some(name) = oracle {
+        cmd.args(["--oracle", name]);
     }
     if o.common.allow_dark {
         cmd.arg("--allow-dark");
@@ -331,20 +336,29 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         if args.scenes.is_empty() { super::GENERATED_SCENES.iter().map(|s| s.to_string()).collect() } else { args.scenes.clone() };
     let exe = std::env::current_exe().context("locating this executable")?;
     let tmp = std::env::temp_dir().join(format!("radiosity-bench-shafts-{}", std::process::id()));
-    const METHODS: [&str; 3] = ["rays", "aabb", "obb"];
+    // (label, visibility, oracle): with `bf-hand` shafts only cull the rays (links as with plain
+    // rays); with the shaft oracle they also decide refinement, so tighter culling means fewer
+    // links. The plain-rays reference uses `bf-hand`: the shaft oracle needs shafts.
+    const METHODS: [(&str, &str, &str); 5] = [
+        ("rays", "rays", "bf-hand"),
+        ("aabb", "aabb", "bf-hand"),
+        ("obb", "obb", "bf-hand"),
+        ("aabb/shaft", "aabb", "shaft"),
+        ("obb/shaft", "obb", "shaft"),
+    ];
     let mut rows = Vec::new();
     if !args.json {
         println!(
-            "{:<18} {:<5} {:>9} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>8} {:>8}",
+            "{:<18} {:<10} {:>9} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>8} {:>8}",
             "scene", "method", "links", "elements", "rays", "time_s", "refine_s", "peak_MB", "max_diff", "speedup", "refine"
         );
     }
     for (i, scene) in scenes.iter().enumerate() {
         let mut runs: Vec<Option<ShaftRun>> = vec![None; METHODS.len()];
         for _ in 0..args.repeats {
-            for (m, method) in METHODS.iter().enumerate() {
-                let out = tmp.join(format!("{i}-{method}"));
-                let s = child_solve(&exe, scene, &args.options, Some(method), &out)?;
+            for (m, &(_, visibility, oracle)) in METHODS.iter().enumerate() {
+                let out = tmp.join(format!("{i}-{m}"));
+                let s = child_solve(&exe, scene, &args.options, Some(visibility), Some(oracle), &out)?;
                 let refine = s["time_s"]["refine"].as_f64().unwrap_or(f64::NAN);
                 let time = refine + s["time_s"]["build"].as_f64().unwrap_or(0.0) + s["time_s"]["solve"].as_f64().unwrap_or(0.0);
                 let (time, refine) = runs[m].as_ref().map_or((time, refine), |r| (r.time.min(time), r.refine.min(refine)));
@@ -354,18 +368,18 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         }
         let ShaftRun { time: rt, refine: rr, radiosity: rb, .. } = runs[0].clone().context("at least one run")?;
         let max = rb.iter().flatten().fold(0.0f64, |m, v| m.max(*v)).max(f64::MIN_POSITIVE);
-        for (method, run) in METHODS.iter().zip(runs) {
+        for (&(method, visibility, oracle), run) in METHODS.iter().zip(runs) {
             let ShaftRun { stats: s, time, refine, radiosity: b } = run.context("at least one run")?;
             let d = rb.iter().zip(&b).flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs())).fold(0.0f64, f64::max);
             let (diff, speedup, refine_speedup) = (d / max, rt / time, rr / refine);
             let row = serde_json::json!({
-                "scene": scene, "method": method, "links": s["links"], "elements": s["elements"], "rays": s["rays"],
+                "scene": scene, "method": method, "visibility": visibility, "oracle": oracle, "links": s["links"], "elements": s["elements"], "rays": s["rays"],
                 "time_s": time, "refine_s": refine, "peak_rss_bytes": s["peak_rss_bytes"], "max_rel_diff_to_rays": diff,
             });
             if !args.json {
                 let name = std::path::Path::new(scene).file_name().and_then(|n| n.to_str()).unwrap_or(scene);
                 println!(
-                    "{:<18} {:<5} {:>9} {:>9} {:>11} {:>9.3} {:>9.3} {:>9.1} {:>10.2e} {:>8.2} {:>8.2}",
+                    "{:<18} {:<10} {:>9} {:>9} {:>11} {:>9.3} {:>9.3} {:>9.1} {:>10.2e} {:>8.2} {:>8.2}",
                     name,
                     method,
                     s["links"].as_u64().unwrap_or(0),
