@@ -16,8 +16,7 @@ fn main() {
     let flat = instancing::flatten(&s, &FlattenOptions::default()).expect("flatten");
     let t = std::time::Instant::now();
     let eps: f64 = std::env::args().nth(2).and_then(|e| e.parse().ok()).unwrap_or(0.01);
-    let mut config = pipeline::Config::default();
-    config.final_gather = std::env::args().nth(3).is_none();
+    let config = pipeline::Config { final_gather: std::env::args().nth(3).is_none(), ..pipeline::Config::default() };
     let solved = pipeline::run(&flat, &BfHand { params: radiosity_core::refine::BfParams { eps } }, &config, &|p| {
         eprintln!("{:.1}s {p:?}", t.elapsed().as_secs_f64())
     });

@@ -306,9 +306,10 @@ fn bad_input_never_panics() {
 }
 
 fn solver_config() -> InstancedConfig {
-    let mut c = InstancedConfig::default();
-    c.properties = PropertyConfig { n_directions: 16, rays_per_direction: 400, ..PropertyConfig::default() };
-    c
+    InstancedConfig {
+        properties: PropertyConfig { n_directions: 16, rays_per_direction: 400, ..PropertyConfig::default() },
+        ..InstancedConfig::default()
+    }
 }
 
 #[test]

@@ -47,9 +47,10 @@ vertices = [[1.5, 1.5, 3.99], [1.5, 2.5, 3.99], [2.5, 2.5, 3.99], [2.5, 1.5, 3.9
 "#;
 
 fn config() -> InstancedConfig {
-    let mut c = InstancedConfig::default();
-    c.properties = PropertyConfig { n_directions: 16, rays_per_direction: 400, ..PropertyConfig::default() };
-    c
+    InstancedConfig {
+        properties: PropertyConfig { n_directions: 16, rays_per_direction: 400, ..PropertyConfig::default() },
+        ..InstancedConfig::default()
+    }
 }
 
 #[test]

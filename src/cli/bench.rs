@@ -227,8 +227,7 @@ fn bench_leave_out(args: &LeaveOutArgs) -> anyhow::Result<()> {
     for (name, scene) in &scenes {
         let mut timed = Vec::new();
         for analyse in [false, true] {
-            let mut config = Config::default();
-            config.analyse = analyse;
+            let mut config = Config { analyse, ..Config::default() };
             config.build.min_area_rel = 1e-4;
             let t = Instant::now();
             let solved = pipeline::run(scene, &oracle, &config, &|_| {});

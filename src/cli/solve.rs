@@ -214,7 +214,7 @@ impl<S: radiosity::instancing::RadiositySink> radiosity::instancing::RadiositySi
         leaves: &[radiosity::instancing::Leaf],
     ) -> Result<(), radiosity::instancing::InstancingError> {
         self.done += 1;
-        if self.done % 4096 == 0 {
+        if self.done.is_multiple_of(4096) {
             self.reporter.phase(&format!("instanced solve: {} of {} polygons finished", self.done, self.total));
         }
         self.inner.polygon(info, leaves)

@@ -58,11 +58,9 @@ pub fn clip_to_halfspace(poly: &[DVec3], x: DVec3, n: DVec3, out: &mut [DVec3; M
     for i in 0..m {
         let j = (i + 1) % m;
         let (di, dj) = (d[i], d[j]);
-        if di >= 0.0 {
-            if count < MAX_CLIPPED {
-                out[count] = poly[i];
-                count += 1;
-            }
+        if di >= 0.0 && count < MAX_CLIPPED {
+            out[count] = poly[i];
+            count += 1;
         }
         if (di >= 0.0) != (dj >= 0.0) {
             let t = di / (di - dj);

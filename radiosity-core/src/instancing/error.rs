@@ -35,12 +35,12 @@ pub enum InstancingError {
         line: usize,
         /// Prototype name.
         prototype: String,
-        /// The OBJ error.
-        source: SceneError,
+        /// The OBJ error (boxed: it is large, and errors travel through every `Result`).
+        source: Box<SceneError>,
     },
     /// A material, or a scene, that the builder rejected.
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Scene(Box<SceneError>),
     /// A cached property file exists but cannot be decoded.
     #[error("{}: corrupt property cache entry: {msg}", path.display())]
     Cache {
@@ -49,6 +49,12 @@ pub enum InstancingError {
         /// Decoder message.
         msg: String,
     },
+}
+
+impl From<SceneError> for InstancingError {
+    fn from(e: SceneError) -> InstancingError {
+        InstancingError::Scene(Box::new(e))
+    }
 }
 
 impl InstancingError {

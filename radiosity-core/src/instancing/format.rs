@@ -278,7 +278,7 @@ impl Ctx<'_> {
                 path: self.path.to_owned(),
                 line,
                 prototype: name.to_owned(),
-                source,
+                source: Box::new(source),
             })?;
             let target = |k: usize| renames.get(&mesh.materials[k].name).map_or(mesh.materials[k].name.as_str(), String::as_str).to_owned();
             let map: Vec<Option<u32>> = (0..mesh.materials.len()).map(|k| self.material(&target(k), line).ok()).collect();

@@ -85,7 +85,7 @@ impl Transform {
         let l = DMat3::from_mat4(self.matrix);
         let scale = l.x_axis.length() * l.y_axis.length() * l.z_axis.length();
         let det = l.determinant();
-        if !(det.abs() > SINGULAR_REL_TOL * scale) || scale == 0.0 {
+        if det.is_nan() || det.abs() <= SINGULAR_REL_TOL * scale || scale == 0.0 {
             return Some(format!("singular transform (determinant {det:e})"));
         }
         None

@@ -472,7 +472,7 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, _a_eff: f64, eps: f64
     }
     scene.materials = materials;
     let intercepted: f64 = scene.polygons.iter().zip(&direct).map(|(p, h)| h * p.poly.area()).sum();
-    if !(intercepted > 0.0) {
+    if intercepted.is_nan() || intercepted <= 0.0 {
         return [0.0; 3];
     }
     let oracle = BfHand { params: BfParams { eps } };

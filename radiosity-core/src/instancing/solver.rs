@@ -210,6 +210,9 @@ struct Proxy {
     albedo: [f64; 3],
 }
 
+/// A polygon of a level's own: geometry (world), material, flattened index, prototype holding it.
+type OwnPolygon = (Poly, u32, u64, PrototypeId);
+
 /// An instance waiting to be opened.
 struct Task {
     prototype: PrototypeId,
@@ -262,7 +265,7 @@ fn solve_depth_first(
         // Gather the level: own polygons of the task and of instances opened in place, and the
         // closed instances; `inlined` records which instances were opened in place (part of the
         // key under which the level is cached).
-        let mut own: Vec<(Poly, u32, u64, PrototypeId)> = Vec::new();
+        let mut own: Vec<OwnPolygon> = Vec::new();
         let mut closed: Vec<(PrototypeId, Transform, u64)> = Vec::new();
         let mut emitters: Vec<Aabb> = Vec::new();
         let mut inlined: Vec<bool> = Vec::new();
@@ -333,7 +336,7 @@ fn solve_depth_first(
         let reused = if class.is_some() { levels.find(&key, &task.transform.matrix) } else { None };
         let mut fresh = None;
         if reused.is_none() {
-            let light = task.incoming.as_deref().zip(class).map(|(field, (_, raise))| (dirs.as_slice(), field, raise));
+            let light = task.incoming.as_deref().zip(class).map(|(field, (_, raise))| OutsideLight { dirs: &dirs, field, raise });
             let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, b_ref_scene, config)? else { continue };
             fresh = Some(level);
         }
@@ -606,10 +609,10 @@ impl Level {
 fn build_level(
     scene: &InstancedScene,
     task: &Task,
-    own: &[(Poly, u32, u64, PrototypeId)],
+    own: &[OwnPolygon],
     closed: &[(PrototypeId, Transform, u64)],
     proxies: &HashMap<PrototypeId, Proxy>,
-    light: Option<(&[DVec3], &[[f64; 3]], f64)>,
+    light: Option<OutsideLight<'_>>,
     b_ref_scene: f64,
     config: &InstancedConfig,
 ) -> Result<Option<Level>, InstancingError> {
@@ -658,7 +661,7 @@ fn build_level(
     let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
     let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
     let mut table = None;
-    if let Some((dirs, field, raise)) = light {
+    if let Some(OutsideLight { dirs, field, raise }) = light {
         let caster = crate::visibility::RayCaster::new(&local);
         let t = VisibilityTable::build(&polys, &caster, local.bounds().diagonal(), config.properties.seed);
         let (external, _) = table_irradiance(&polys, &t, dirs, field, &[]);
@@ -695,6 +698,15 @@ fn build_level(
         solution: light.is_none().then_some(solved.solution),
         iterations: solved.iterations,
     }))
+}
+
+/// The light from outside a level: the field of beams in directions `dirs`, and the factor that
+/// raises it to the top of its brightness class.
+#[derive(Clone, Copy)]
+struct OutsideLight<'a> {
+    dirs: &'a [DVec3],
+    field: &'a [[f64; 3]],
+    raise: f64,
 }
 
 /// Settings of every local solve.

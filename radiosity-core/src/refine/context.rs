@@ -140,10 +140,10 @@ impl<'a> LinkCtx<'a> {
 
     /// The form factor at (at least) the given quality, computed once per quality level.
     pub fn form_factor(&mut self, quality: FormFactorQuality) -> f64 {
-        if let Some((f, q)) = self.data.form_factor {
-            if q >= quality {
-                return f;
-            }
+        if let Some((f, q)) = self.data.form_factor
+            && q >= quality
+        {
+            return f;
         }
         let h = self.services.hierarchy;
         let f = match quality {
@@ -166,10 +166,10 @@ impl<'a> LinkCtx<'a> {
 
     /// Visibility fraction with at least `rays` rays (1 when the scene needs no visibility).
     pub fn visibility(&mut self, rays: u32) -> f64 {
-        if let Some((v, n)) = self.data.visibility {
-            if n >= rays {
-                return v;
-            }
+        if let Some((v, n)) = self.data.visibility
+            && n >= rays
+        {
+            return v;
         }
         let v = match (self.services.caster, self.services.shafts) {
             (None, _) => 1.0,

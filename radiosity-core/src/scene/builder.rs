@@ -174,7 +174,7 @@ fn is_degenerate(vs: &[DVec3]) -> bool {
         longest2 = longest2.max((vs[(i + 1) % vs.len()] - vs[i]).length_squared());
     }
     let area = newell(vs).length();
-    !(area > DEGENERATE_REL_AREA * longest2) || longest2 == 0.0
+    area.is_nan() || area <= DEGENERATE_REL_AREA * longest2 || longest2 == 0.0
 }
 
 fn is_planar_convex_quad(vs: &[DVec3]) -> bool {

@@ -124,7 +124,7 @@ impl RayCaster {
         let (la, lb) = (self.to_local(a), self.to_local(b));
         let d = lb - la;
         let len = d.length();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return true;
         }
         let dir = d / len;
