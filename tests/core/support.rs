@@ -31,6 +31,13 @@ impl Build {
         self.b.material(m).expect("valid test material")
     }
 
+    /// Adds a material with a diffuse transmittance (two-sided); returns its index.
+    pub fn transmitting(&mut self, name: &str, rho: [f64; 3], t: [f64; 3]) -> u32 {
+        let mut m = Material::diffuse(name, rho);
+        m.transmittance = t;
+        self.b.material(m).expect("valid test material")
+    }
+
     /// Adds a quad in group `group`.
     pub fn quad(&mut self, group: &str, v: [DVec3; 4], material: u32) {
         let g = self.b.group(group);

@@ -20,6 +20,39 @@ impl Default for BuildConfig {
     }
 }
 
+/// Relative tolerance of [`twins`]: how far apart (relative to the polygon's size) the centroids of
+/// the two sides may be.
+pub const TWIN_REL_TOL: f64 = 1e-9;
+
+/// The two sides of every transmitting surface: consecutive polygons with the same reflectance and
+/// a positive transmittance (their materials may differ in emission), the second the first reversed
+/// (same centroid and area, opposite normal), as the flattening of two-sided surfaces writes them.
+#[must_use]
+pub fn twins(scene: &Scene) -> Vec<u32> {
+    let n = scene.polygons.len();
+    let mut twin = vec![NONE; n];
+    let mut k = 0;
+    while k + 1 < n {
+        let (a, b) = (&scene.polygons[k], &scene.polygons[k + 1]);
+        let (m, mb) = (&scene.materials[a.material as usize], &scene.materials[b.material as usize]);
+        let size = a.poly.area().sqrt();
+        if m.reflectance == mb.reflectance
+            && m.transmittance == mb.transmittance
+            && m.transmittance.iter().any(|&t| t > 0.0)
+            && (a.poly.centroid() - b.poly.centroid()).length() <= TWIN_REL_TOL * size.max(f64::MIN_POSITIVE)
+            && (a.poly.area() - b.poly.area()).abs() <= TWIN_REL_TOL * a.poly.area()
+            && a.poly.normal().dot(b.poly.normal()) < 0.0
+        {
+            twin[k] = (k + 1) as u32;
+            twin[k + 1] = k as u32;
+            k += 2;
+        } else {
+            k += 1;
+        }
+    }
+    twin
+}
+
 /// Builds the hierarchy of `scene`: one root surface element per polygon (ids `0..n`), then clusters.
 #[must_use]
 pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
@@ -30,6 +63,13 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
     }
     let reflectance = scene.polygons.iter().map(|p| scene.materials[p.material as usize].reflectance).collect();
     let emission = scene.polygons.iter().map(|p| scene.materials[p.material as usize].emission).collect();
+    let twin = twins(scene);
+    let transmittance = scene
+        .polygons
+        .iter()
+        .zip(&twin)
+        .map(|(p, &t)| if t == NONE { [0.0; 3] } else { scene.materials[p.material as usize].transmittance })
+        .collect();
     let total_area: f64 = elements.iter().map(|e| e.area).sum();
     let mut h = Hierarchy {
         elements,
@@ -40,6 +80,8 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         n_polygons: n as u32,
         reflectance,
         emission,
+        transmittance,
+        twin,
         min_area: config.min_area_rel * total_area,
     };
     let centroids: Vec<DVec3> = h.elements.iter().map(|e| e.center).collect();

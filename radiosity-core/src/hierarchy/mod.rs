@@ -8,7 +8,7 @@
 
 mod build;
 
-pub use build::{BuildConfig, build};
+pub use build::{BuildConfig, TWIN_REL_TOL, build, twins};
 
 use crate::geom::{Aabb, DVec3, Poly};
 
@@ -107,6 +107,12 @@ pub struct Hierarchy {
     pub reflectance: Vec<[f64; 3]>,
     /// Emission (W/m²) per input polygon.
     pub emission: Vec<[f64; 3]>,
+    /// Diffuse transmittance per input polygon (0 unless the polygon has a [`Hierarchy::twin`]).
+    pub transmittance: Vec<[f64; 3]>,
+    /// The other side of a two-sided, transmitting surface (the same polygon reversed, stored as
+    /// the next or previous input polygon), or [`NONE`]: a side's radiosity is
+    /// `E + ρ·H(this side) + t·H̄(other side)`, `H̄` the other side's mean irradiance.
+    pub twin: Vec<u32>,
     /// Smallest area a surface element may be subdivided into.
     pub min_area: f64,
 }

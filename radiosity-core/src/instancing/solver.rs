@@ -362,9 +362,15 @@ fn solve_depth_first(
         let solution = match level.solution.take() {
             Some(solution) => solution,
             None => {
-                for (i, e) in level.h.emission.iter_mut().enumerate() {
+                let h = &mut level.h;
+                for i in 0..h.emission.len() {
+                    // The first reflection of the light from outside, and its transmission from
+                    // the other side of a transmitting leaf.
                     let ext = external.get(i).copied().unwrap_or([0.0; 3]);
-                    *e = std::array::from_fn(|c| level.base_emission[i][c] + level.h.reflectance[i][c] * ext[c]);
+                    let other = external.get(h.twin[i] as usize).copied().unwrap_or([0.0; 3]);
+                    h.emission[i] = std::array::from_fn(|c| {
+                        level.base_emission[i][c] + h.reflectance[i][c] * ext[c] + h.transmittance[i][c] * other[c]
+                    });
                 }
                 let pipeline_config = local_pipeline(config);
                 if level.leaf.is_none()
@@ -666,11 +672,14 @@ fn build_level(
         let t = VisibilityTable::build(&polys, &caster, local.bounds().diagonal(), config.properties.seed);
         let (external, _) = table_irradiance(&polys, &t, dirs, field, &[]);
         table = Some(t);
+        let twin = crate::hierarchy::twins(&local);
         let mut materials = Vec::with_capacity(local.polygons.len());
         for (i, p) in local.polygons.iter_mut().enumerate() {
             let mut m = local.materials[p.material as usize].clone();
             m.name = format!("p{i}");
-            m.emission = std::array::from_fn(|c| m.emission[c] + m.reflectance[c] * raise * external[i][c]);
+            let other = external.get(twin[i] as usize).copied().unwrap_or([0.0; 3]);
+            let through = if twin[i] == crate::hierarchy::NONE { [0.0; 3] } else { m.transmittance };
+            m.emission = std::array::from_fn(|c| m.emission[c] + raise * (m.reflectance[c] * external[i][c] + through[c] * other[c]));
             materials.push(m);
             p.material = i as u32;
         }

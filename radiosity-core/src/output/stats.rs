@@ -86,12 +86,12 @@ pub fn power_balance(h: &Hierarchy, solution: &Solution) -> (f64, f64, [f64; 3])
     for leaf in h.leaves() {
         let e = h.get(leaf);
         let Some(p) = e.polygon() else { continue };
-        let (rho, em) = (h.reflectance[p as usize], h.emission[p as usize]);
+        let (rho, em, t) = (h.reflectance[p as usize], h.emission[p as usize], h.transmittance[p as usize]);
         let hh = solution.irradiance[leaf as usize];
         let b = solution.radiosity[leaf as usize];
         for c in 0..3 {
             emitted += e.area * em[c] / 3.0;
-            absorbed += e.area * (1.0 - rho[c]) * hh[c] / 3.0;
+            absorbed += e.area * (1.0 - rho[c] - t[c]) * hh[c] / 3.0;
             mean[c] += e.area * b[c];
         }
         area += e.area;

@@ -30,10 +30,8 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
         .collect();
     let mut b = radiosity.to_vec();
     let mut irr = vec![[0.0; 3]; n];
-    for (&leaf, g) in leaves.iter().zip(gathered) {
-        let p = h.get(leaf).polygon().expect("leaves are surfaces") as usize;
-        irr[leaf as usize] = g;
-        b[leaf as usize] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * g[c]);
+    for (&leaf, g) in leaves.iter().zip(&gathered) {
+        irr[leaf as usize] = *g;
     }
     // Inner elements: area-weighted means, children before parents (reverse breadth-first order).
     let mut order = vec![h.root];
@@ -42,26 +40,37 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
         order.extend_from_slice(h.children_of(order[i]));
         i += 1;
     }
+    area_means(h, &order, &mut irr);
+    for (&leaf, g) in leaves.iter().zip(gathered) {
+        let p = h.get(leaf).polygon().expect("leaves are surfaces") as usize;
+        // A transmitting side passes on the light of its other side.
+        let q = h.twin[p];
+        let through = if q == crate::hierarchy::NONE { [0.0; 3] } else { irr[q as usize] };
+        b[leaf as usize] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * g[c] + h.transmittance[p][c] * through[c]);
+    }
+    area_means(h, &order, &mut b);
+    (b, irr)
+}
+
+/// Sets every inner element of `order` (parents before children) to the area-weighted mean of its
+/// children.
+fn area_means(h: &Hierarchy, order: &[ElementId], values: &mut [[f64; 3]]) {
     for &e in order.iter().rev() {
         let kids = h.children_of(e);
         if kids.is_empty() {
             continue;
         }
-        let mut ab = [0.0; 3];
-        let mut ah = [0.0; 3];
+        let mut acc = [0.0; 3];
         let mut area = 0.0;
         for &k in kids {
             let a = h.get(k).area;
             for c in 0..3 {
-                ab[c] += a * b[k as usize][c];
-                ah[c] += a * irr[k as usize][c];
+                acc[c] += a * values[k as usize][c];
             }
             area += a;
         }
         if area > 0.0 {
-            b[e as usize] = ab.map(|v| v / area);
-            irr[e as usize] = ah.map(|v| v / area);
+            values[e as usize] = acc.map(|v| v / area);
         }
     }
-    (b, irr)
 }

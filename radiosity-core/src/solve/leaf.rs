@@ -200,8 +200,12 @@ impl<'a> LeafOperator<'a> {
         let rho = self.op.reflectance();
         for (i, h) in hs.iter().enumerate() {
             for k in 0..3 {
-                y[3 * i + k] = x[3 * i + k] - rho[3 * i + k] * h[k];
+                y[3 * i + k] = rho[3 * i + k] * h[k];
             }
+        }
+        self.op.add_transmitted(&hs, y);
+        for (yi, xi) in y.iter_mut().zip(x) {
+            *yi = xi - *yi;
         }
     }
 

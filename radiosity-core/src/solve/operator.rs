@@ -20,6 +20,9 @@ pub struct Operator<'a> {
     /// Leaf reflectance and emission, interleaved RGB.
     rho: Vec<f64>,
     emission: Vec<f64>,
+    /// Per leaf: transmittance and the other side's polygon (see [`Hierarchy::twin`]); empty when
+    /// no leaf transmits.
+    through: Vec<([f64; 3], ElementId)>,
     /// Scratch: per-element radiosity and irradiance (interior mutability avoided: rebuilt each call).
     n: usize,
 }
@@ -63,7 +66,17 @@ impl<'a> Operator<'a> {
             rho.extend_from_slice(&h.reflectance[poly]);
             emission.extend_from_slice(&h.emission[poly]);
         }
-        Operator { h, order, leaves, leaf_index, links: packed, groups, rho, emission, n }
+        let mut through: Vec<([f64; 3], ElementId)> = leaves
+            .iter()
+            .map(|&e| {
+                let p = h.get(e).polygon().expect("leaves are surfaces") as usize;
+                (h.transmittance[p], h.twin[p])
+            })
+            .collect();
+        if through.iter().all(|(_, q)| *q == NONE) {
+            through.clear();
+        }
+        Operator { h, order, leaves, leaf_index, links: packed, groups, rho, emission, through, n }
     }
 
     /// Number of unknowns (3 per leaf).
@@ -190,7 +203,7 @@ impl<'a> Operator<'a> {
         hsum
     }
 
-    /// `y = M x`: the reflected radiosity of the leaves for leaf radiosity `x`.
+    /// `y = M x`: the reflected (and transmitted) radiosity of the leaves for leaf radiosity `x`.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         let b = self.pull(x);
         let gathered = self.gather(&b);
@@ -198,6 +211,27 @@ impl<'a> Operator<'a> {
         for (i, &e) in self.leaves.iter().enumerate() {
             for k in 0..3 {
                 y[3 * i + k] = self.rho[3 * i + k] * hsum[e as usize][k];
+            }
+        }
+        let leaf_h: Vec<[f64; 3]> =
+            if self.through.is_empty() { Vec::new() } else { self.leaves.iter().map(|&e| hsum[e as usize]).collect() };
+        self.add_transmitted(&leaf_h, y);
+    }
+
+    /// Adds `t·H̄(other side)` to every transmitting leaf's entry of `y`, for leaf irradiance
+    /// `leaf_h` (leaf order; `H̄` the other side's area-weighted mean). Nothing when no leaf
+    /// transmits.
+    pub fn add_transmitted(&self, leaf_h: &[[f64; 3]], y: &mut [f64]) {
+        if self.through.is_empty() {
+            return;
+        }
+        let flat: Vec<f64> = leaf_h.iter().flatten().copied().collect();
+        let mean = self.pull(&flat);
+        for (i, &(t, q)) in self.through.iter().enumerate() {
+            if q != NONE {
+                for k in 0..3 {
+                    y[3 * i + k] += t[k] * mean[q as usize][k];
+                }
             }
         }
     }
