@@ -404,7 +404,9 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
 
 fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     use radiosity::instancing::bench::{BenchRow, bench_full, bench_instanced, load_means, save_means};
-    use radiosity::instancing::solver::relative_error;
+    use radiosity::instancing::solver::{polygons_above, relative_error};
+    // Polygons whose error exceeds this fraction of the largest radiosity are counted.
+    const ERROR_COUNT_FRACTION: f64 = 0.03;
     use radiosity::instancing::{ForestParams, InstancedConfig, generate_forest, generate_tree};
     anyhow::ensure!((1..=200).contains(&args.age), "--age must be between 1 and 200");
     anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
@@ -455,7 +457,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     // Every threshold, finest first: both methods, each in its own process (peak RSS per process).
     let mut thresholds = vec![args.eps];
     thresholds.extend(args.sweep.iter().copied().filter(|&e| e != args.eps));
-    let mut points: Vec<(BenchRow, f64, f64)> = Vec::new();
+    let mut points: Vec<(BenchRow, f64, f64, usize)> = Vec::new();
     let mut reference = None;
     for (k, &eps) in thresholds.iter().enumerate() {
         for method in ["full", "instanced"] {
@@ -468,11 +470,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
             let _ = std::fs::remove_file(&file);
             if k == 0 && method == "full" {
                 reference = Some(means);
-                points.push((row, 0.0, 0.0));
+                points.push((row, 0.0, 0.0, 0));
                 continue;
             }
-            let (worst, mean) = relative_error(reference.as_ref().expect("the full solve at --eps runs first"), &means);
-            points.push((row, worst, mean));
+            let reference = reference.as_ref().expect("the full solve at --eps runs first");
+            let (worst, mean) = relative_error(reference, &means);
+            points.push((row, worst, mean, polygons_above(reference, &means, ERROR_COUNT_FRACTION)));
         }
     }
     let mut forests: Vec<(u32, BenchRow)> = Vec::new();
@@ -495,19 +498,20 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     }
     // Error against time: CSV and plot.
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
-    let mut csv = String::from("method,eps,time_s,peak_rss_bytes,links,error_pct_of_max,error_mean_pct_of_max\n");
-    for (r, worst, mean) in &points {
-        csv += &format!("{},{},{},{},{},{},{}\n", r.method, r.eps, r.seconds, r.peak_rss_bytes, r.links, 100.0 * worst, 100.0 * mean);
+    let mut csv = String::from("method,eps,time_s,peak_rss_bytes,links,error_pct_of_max,error_mean_pct_of_max,polygons_above_3pct\n");
+    for (r, worst, mean, above) in &points {
+        csv +=
+            &format!("{},{},{},{},{},{},{},{above}\n", r.method, r.eps, r.seconds, r.peak_rss_bytes, r.links, 100.0 * worst, 100.0 * mean);
     }
     let csv_path = args.out.join("instancing_error_time.csv");
     std::fs::write(&csv_path, csv).with_context(|| format!("{}: cannot write", csv_path.display()))?;
     let plotted: Vec<(String, f64, f64, f64)> =
-        points.iter().filter(|p| p.1 > 0.0).map(|(r, worst, _)| (r.method.clone(), r.seconds, 100.0 * worst, 0.0)).collect();
+        points.iter().filter(|p| p.1 > 0.0).map(|(r, worst, _, _)| (r.method.clone(), r.seconds, 100.0 * worst, 0.0)).collect();
     let svg_path = args.out.join("instancing_error_time.svg");
     let title = format!("tree age {} (reference: full at eps {})", args.age, args.eps);
     std::fs::write(&svg_path, super::sweep::svg_plot(&title, &plotted)).with_context(|| format!("{}: cannot write", svg_path.display()))?;
 
-    let (rf, ri, worst, mean) = (&points[0].0, &points[1].0, points[1].1, points[1].2);
+    let (rf, ri, worst, mean, above) = (&points[0].0, &points[1].0, points[1].1, points[1].2, points[1].3);
     if args.json {
         let doc = serde_json::json!({
             "tree": {
@@ -518,10 +522,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
                 "instanced": {"time_s": ri.seconds, "peak_rss_bytes": ri.peak_rss_bytes, "links": ri.links},
                 "error_pct_of_max": 100.0 * worst,
                 "error_mean_pct_of_max": 100.0 * mean,
+                "polygons_above_3pct": above,
             },
-            "error_time": points.iter().map(|(r, w, m)| serde_json::json!({
+            "error_time": points.iter().map(|(r, w, m, a)| serde_json::json!({
                 "method": r.method, "eps": r.eps, "time_s": r.seconds, "peak_rss_bytes": r.peak_rss_bytes,
                 "links": r.links, "error_pct_of_max": 100.0 * w, "error_mean_pct_of_max": 100.0 * m,
+                "polygons_above_3pct": a,
             })).collect::<Vec<_>>(),
             "forests": forests.iter().map(|(trees, r)| serde_json::json!({
                 "trees": trees, "polygons": r.polygons, "time_s": r.seconds, "peak_rss_bytes": r.peak_rss_bytes, "links": r.links,
@@ -532,12 +538,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     }
     println!("tree age {} seed {}, {} polygons (two-sided leaves as pairs), eps {}", args.age, args.seed, rf.polygons, args.eps);
     println!(
-        "{:<10} {:>7} {:>10} {:>10} {:>10} {:>8} {:>10} {:>10}",
-        "method", "eps", "time_s", "peak_MB", "links", "solves", "err_max%", "err_mean%"
+        "{:<10} {:>7} {:>10} {:>10} {:>10} {:>8} {:>10} {:>10} {:>8}",
+        "method", "eps", "time_s", "peak_MB", "links", "solves", "err_max%", "err_mean%", "n>3%"
     );
-    for (r, w, m) in &points {
+    for (r, w, m, a) in &points {
         println!(
-            "{:<10} {:>7} {:>10.3} {:>10.1} {:>10} {:>8} {:>10.2} {:>10.3}",
+            "{:<10} {:>7} {:>10.3} {:>10.1} {:>10} {:>8} {:>10.2} {:>10.3} {:>8}",
             r.method,
             r.eps,
             r.seconds,
@@ -545,16 +551,18 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
             r.links,
             r.local_solves,
             100.0 * w,
-            100.0 * m
+            100.0 * m,
+            a
         );
     }
     println!(
-        "instanced vs full at eps {}: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity",
+        "instanced vs full at eps {}: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity ({above} of {} polygons above 3%)",
         args.eps,
         rf.seconds / ri.seconds.max(1e-9),
         rf.peak_rss_bytes as f64 / ri.peak_rss_bytes.max(1) as f64,
         100.0 * worst,
-        100.0 * mean
+        100.0 * mean,
+        rf.polygons
     );
     if !forests.is_empty() {
         println!("{:<8} {:>12} {:>10} {:>10} {:>12}", "trees", "polygons", "time_s", "peak_MB", "links");

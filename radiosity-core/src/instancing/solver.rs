@@ -993,6 +993,22 @@ pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(P
     Ok((means, solved.links.len() as u64))
 }
 
+/// Polygons of `approx` whose error (largest over the channels) exceeds `fraction` of the largest
+/// radiosity of `reference`.
+#[must_use]
+pub fn polygons_above(reference: &PolygonMeans, approx: &PolygonMeans, fraction: f64) -> usize {
+    let b_max = reference.radiosity.iter().flat_map(|b| b.iter().copied()).fold(0.0, f64::max);
+    reference
+        .radiosity
+        .iter()
+        .enumerate()
+        .filter(|(i, r)| {
+            let a = approx.radiosity.get(*i).copied().unwrap_or([0.0; 3]);
+            (0..3).any(|c| (r[c] - a[c]).abs() > fraction * b_max)
+        })
+        .count()
+}
+
 /// Error of `approx` against `reference`, per polygon and channel, as a fraction of the largest
 /// radiosity of `reference`: `(max error, area-weighted mean error)`.
 #[must_use]
