@@ -52,3 +52,20 @@ fn duplex_agrees_with_plain_rays() {
     let worst = compare(&duplex());
     assert!(worst < AGREEMENT_TOL, "worst polygon differs by {:.1}% of max", 100.0 * worst);
 }
+
+/// The shaft oracle's tools declare that they need shafts, so a library solve with the default
+/// configuration (plain rays requested) classifies shafts without being told.
+#[test]
+fn the_shaft_oracle_gets_shafts_from_a_default_pipeline() {
+    use radiosity::oracle::registry;
+    use radiosity::pipeline::{self, Config, VisibilityMethod};
+    use radiosity::refine::Oracle;
+    let shaft = registry::oracle("shaft", &[]).unwrap();
+    let bf = registry::oracle("bf", &[]).unwrap();
+    assert!(shaft.needs().shafts);
+    assert!(!bf.needs().shafts);
+    assert_ne!(pipeline::effective_visibility(shaft.as_ref(), VisibilityMethod::Rays), VisibilityMethod::Rays);
+    let scene = radiosity::scene::generated::stairs_with_beam();
+    let solved = pipeline::run(&scene, shaft.as_ref(), &Config::default(), &|_| {});
+    assert!(solved.shaft_classified.iter().sum::<u64>() > 0, "no shaft was classified");
+}

@@ -149,7 +149,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let use_visibility = config.use_visibility && traits.as_ref().is_none_or(|t| t.needs_visibility);
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
-    let shaft_objects = match config.visibility_method {
+    let shaft_objects = match effective_visibility(oracle, config.visibility_method) {
         VisibilityMethod::Shafts(volume) if use_visibility => Some(crate::visibility::shaft::ShaftObjects::new(
             scene,
             &crate::visibility::shaft::ObjectConfig { volume, ..Default::default() },
@@ -230,6 +230,17 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         error_estimate,
         iterations,
         timings,
+    }
+}
+
+/// The visibility method a solve with `oracle` uses: `requested`, except that an oracle that needs
+/// shafts ([`crate::refine::Needs::shafts`]) gets OBB shafts where plain rays were requested.
+#[must_use]
+pub fn effective_visibility(oracle: &dyn Oracle, requested: VisibilityMethod) -> VisibilityMethod {
+    if oracle.needs().shafts && requested == VisibilityMethod::Rays {
+        VisibilityMethod::Shafts(crate::visibility::shaft::BoundingVolume::Obb)
+    } else {
+        requested
     }
 }
 

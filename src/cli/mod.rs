@@ -171,13 +171,3 @@ pub fn read_patches(path: &Path) -> anyhow::Result<Vec<[f64; 3]>> {
         })
         .collect()
 }
-
-/// `config` adjusted for oracle `name`: the shaft oracle reads shaft classifications, so it turns
-/// OBB shaft culling on unless the user chose a bounding volume.
-pub fn config_for_oracle(name: &str, mut config: radiosity::pipeline::Config) -> radiosity::pipeline::Config {
-    use radiosity::pipeline::VisibilityMethod;
-    if name == "shaft" && config.visibility_method == VisibilityMethod::Rays {
-        config.visibility_method = VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Obb);
-    }
-    config
-}

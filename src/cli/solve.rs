@@ -78,7 +78,9 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         params.push(("eps".to_string(), args.options.eps));
     }
     let oracle = radiosity::oracle::registry::oracle(&args.oracle, &params)?;
-    let config = super::config_for_oracle(&args.oracle, args.options.config());
+    // The method the solve will use (an oracle that needs shafts gets them), as stats.json reports it.
+    let mut config = args.options.config();
+    config.visibility_method = pipeline::effective_visibility(oracle.as_ref(), config.visibility_method);
     let solved = pipeline::run(&scene, oracle.as_ref(), &config, &|p| reporter.event(p));
     reporter.phase("writing outputs");
     let t_out = Instant::now();

@@ -95,7 +95,6 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         for &eps in &args.eps {
             let oracle = oracle_by_name(name, eps)?;
             let t = Instant::now();
-            let config = super::config_for_oracle(name, config);
             let solved = pipeline::run(&scene, oracle.as_ref(), &config, &|_| {});
             let time = t.elapsed().as_secs_f64();
             let b = per_polygon(&solved);

@@ -27,6 +27,8 @@ use crate::refine::LinkCtx;
 pub trait Tool {
     /// The answer enum.
     type Answer: Answer;
+    /// What the tool needs the pipeline to provide (shaft culling for the shaft tools).
+    const NEEDS: crate::refine::Needs = crate::refine::Needs::NONE;
     /// Asks the tool about the link; may compute and memoise link data in `ctx`.
     fn ask(&self, ctx: &mut LinkCtx<'_>) -> Self::Answer;
 }

@@ -26,7 +26,11 @@ pub const ORACLES: &[OracleInfo] = &[
     OracleInfo { name: "bf", release: "flat", doc: "classic BF refiner compiled by `oracle!`" },
     OracleInfo { name: "bf-dag", release: "dag", doc: "classic BF refiner interpreted by the DAG runtime" },
     OracleInfo { name: "bf-hand", release: "hand", doc: "classic BF refiner written by hand (the baseline)" },
-    OracleInfo { name: "shaft", release: "flat", doc: "shaft oracle compiled by `oracle!` (solve turns on OBB shaft culling)" },
+    OracleInfo {
+        name: "shaft",
+        release: "flat",
+        doc: "shaft oracle compiled by `oracle!` (its tools need shafts: OBB culling unless another volume is chosen)",
+    },
 ];
 
 /// Why a name did not give an oracle.

@@ -2,9 +2,9 @@
 //! build the link's shaft; if one occluder blocks it whole, stop; if any candidate occluder enters
 //! it, the smallest form factor is taken as 0; if the form factor error `B_S · (F_max − F_min)`
 //! exceeds `eps · B_ref`, subdivide; otherwise link (the driver then computes the visibility by
-//! rays against the shaft's candidates only). Needs shaft culling enabled in the pipeline
-//! ([`crate::pipeline::VisibilityMethod::Shafts`]); without it every link counts as partly
-//! occluded and the oracle is BF on `F_max`.
+//! rays against the shaft's candidates only). Its tools declare that they need shaft culling
+//! ([`crate::refine::Needs::SHAFTS`]), so [`crate::pipeline::run`] turns OBB shafts on when the
+//! configuration asks for plain rays.
 
 use super::Tool;
 use crate::refine::LinkCtx;
@@ -29,6 +29,7 @@ pub struct ShaftClassify;
 
 impl Tool for ShaftClassify {
     type Answer = ShaftAnswer;
+    const NEEDS: crate::refine::Needs = crate::refine::Needs::SHAFTS;
     fn ask(&self, ctx: &mut LinkCtx<'_>) -> ShaftAnswer {
         match ctx.shaft_verdict() {
             Some(ShaftClass::Invisible) => ShaftAnswer::Invisible,
@@ -55,6 +56,7 @@ pub struct ShaftFfError(pub f64);
 
 impl Tool for ShaftFfError {
     type Answer = FfError;
+    const NEEDS: crate::refine::Needs = crate::refine::Needs::SHAFTS;
     fn ask(&self, ctx: &mut LinkCtx<'_>) -> FfError {
         let f_max = ctx.form_factor_max();
         let f_min = match ctx.shaft_verdict() {

@@ -32,4 +32,32 @@ pub trait Oracle: Sync {
     fn name(&self) -> &str;
     /// Decides for one link. The driver never asks about a self-link (emitter == receiver).
     fn decide(&self, ctx: &mut LinkCtx<'_>) -> Decision;
+    /// What the oracle needs the pipeline to provide beyond the defaults ([`crate::pipeline::run`]
+    /// turns it on). An oracle compiled by `oracle!` needs what any of its tools needs
+    /// ([`crate::oracle::Tool::NEEDS`]).
+    fn needs(&self) -> Needs {
+        Needs::NONE
+    }
+}
+
+/// Pipeline services an oracle or a tool needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Needs {
+    /// Shaft culling, for [`LinkCtx::shaft_verdict`] (without it every link is "partly
+    /// occluded"): [`crate::pipeline::run`] then uses OBB shafts if the configuration asks for
+    /// plain rays.
+    pub shafts: bool,
+}
+
+impl Needs {
+    /// Nothing beyond the defaults.
+    pub const NONE: Needs = Needs { shafts: false };
+    /// Shaft culling.
+    pub const SHAFTS: Needs = Needs { shafts: true };
+
+    /// Both sets of needs.
+    #[must_use]
+    pub const fn union(self, other: Needs) -> Needs {
+        Needs { shafts: self.shafts || other.shafts }
+    }
 }
