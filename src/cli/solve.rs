@@ -39,6 +39,10 @@ pub struct SolveArgs {
     /// like a `.toml` scene (`patches.csv` is then in flattening order).
     #[arg(long, value_enum, default_value_t = Instances::None)]
     pub instances: Instances,
+    /// Instanced scenes: memory (MB) for the local problems kept for reuse by later instances of
+    /// the same prototype (0: refine every instance anew; slower, a little less memory).
+    #[arg(long, default_value_t = 16.0, value_name = "MB")]
+    pub level_cache_mb: f64,
 }
 
 /// Values of `--instances`.
@@ -54,6 +58,11 @@ pub enum Instances {
 pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     args.options.validate()?;
     anyhow::ensure!((1..=16384).contains(&args.size), "--size must be between 1 and 16384, got {}", args.size);
+    anyhow::ensure!(
+        args.level_cache_mb.is_finite() && (0.0..=1e6).contains(&args.level_cache_mb),
+        "--level-cache-mb must be between 0 and 1e6, got {}",
+        args.level_cache_mb
+    );
     if args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"))) {
         let path = args.scene.as_ref().expect("checked above");
         let scene = radiosity::instancing::load(path)?;
@@ -163,6 +172,7 @@ fn solve_instanced(
     let mut config = InstancedConfig { cache_dir: Some(args.out.join("prototype-cache")), trace, ..InstancedConfig::default() };
     config.bf.eps = args.options.eps;
     config.pipeline = args.options.config();
+    config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
     let stats = instancing::solve_instanced(scene, &config, &mut sink)?;

@@ -101,7 +101,7 @@ impl Default for InstancedConfig {
             local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
             local_leaf_operator_max_entries: 250_000,
             open_near_emitter: 1.0,
-            level_cache_bytes: 16 << 20,
+            level_cache_bytes: 16_000_000,
         }
     }
 }
