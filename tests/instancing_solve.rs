@@ -220,3 +220,28 @@ fn reused_levels_give_the_answer_of_fresh_ones() {
     assert!(worst <= REUSE_MAX_TOL, "reused vs fresh levels: max difference {worst:e}");
     assert!(mean <= REUSE_MEAN_TOL, "reused vs fresh levels: mean difference {mean:e}");
 }
+
+/// Policy `none` vs the full solve: the same problem up to rounding in how the instance transforms
+/// are composed, which can flip a refinement decision (measured 3.4e-4 of the largest radiosity).
+const POLICY_NONE_TOL: f64 = 1e-3;
+
+#[test]
+fn instance_level_policy_none_opens_everything_and_gives_the_full_answer() {
+    use radiosity_core::instancing::InstanceLevels;
+    let scene = parse(&eight_cubes());
+    let c = InstancedConfig { instance_levels: InstanceLevels::None, ..config() };
+    let (full, _) = solve_full(&scene, &c).unwrap();
+    let mut inst = PolygonMeans::default();
+    let stats = solve_instanced(&scene, &c, &mut inst).unwrap();
+    assert_eq!(stats.local_solves, 1, "one flattened problem");
+    let (worst, _) = relative_error(&full, &inst);
+    assert!(worst <= POLICY_NONE_TOL, "policy none vs full: {worst:e}");
+    // Depth 1 is not a multiple of 2: every-2 opens the cubes too; every-1 is all.
+    let mut two = PolygonMeans::default();
+    let s2 = solve_instanced(&scene, &InstancedConfig { instance_levels: InstanceLevels::Every(2), ..config() }, &mut two).unwrap();
+    assert_eq!(s2.local_solves, 1);
+    let s1 = solve_instanced(&scene, &InstancedConfig { instance_levels: InstanceLevels::Every(1), ..config() }, &mut PolygonMeans::default()).unwrap();
+    assert_eq!(s1.local_solves, 9);
+    assert_eq!("every-3".parse::<InstanceLevels>(), Ok(InstanceLevels::Every(3)));
+    assert!("every-0".parse::<InstanceLevels>().is_err() && "some".parse::<InstanceLevels>().is_err());
+}

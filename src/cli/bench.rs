@@ -69,6 +69,9 @@ pub struct InstancingBenchArgs {
     /// Print one JSON document instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Which nesting depths the instanced solves keep closed: `all`, `every-N` or `none`.
+    #[arg(long, default_value = "all", value_name = "POLICY")]
+    pub instance_levels: String,
     /// Internal: run one method (`full` or `instanced`) and write its per-polygon means here.
     #[arg(long, hide = true, num_args = 2, value_names = ["METHOD", "FILE"])]
     pub child: Vec<String>,
@@ -410,8 +413,10 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     use radiosity::instancing::{ForestParams, InstancedConfig, generate_forest, generate_tree};
     anyhow::ensure!((1..=200).contains(&args.age), "--age must be between 1 and 200");
     anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
+    let instance_levels: radiosity::instancing::InstanceLevels =
+        args.instance_levels.parse().map_err(|e: String| anyhow::anyhow!("--instance-levels: {e}"))?;
     let config = |eps: f64| {
-        let mut config = InstancedConfig::default();
+        let mut config = InstancedConfig { instance_levels, ..InstancedConfig::default() };
         config.bf.eps = eps;
         config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
         config
@@ -447,6 +452,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     let run_child = |extra: &[String]| -> anyhow::Result<BenchRow> {
         let o = Command::new(&exe)
             .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string()])
+            .args(["--instance-levels", &args.instance_levels])
             .args(extra)
             .output()
             .with_context(|| format!("running {}", exe.display()))?;

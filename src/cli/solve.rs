@@ -43,6 +43,10 @@ pub struct SolveArgs {
     /// the same prototype (0: refine every instance anew; slower, a little less memory).
     #[arg(long, default_value_t = 16.0, value_name = "MB")]
     pub level_cache_mb: f64,
+    /// Instanced scenes: which nesting depths keep their instances closed: `all`, `every-N`
+    /// (depths N, 2N, ...; the others are opened in place), or `none` (one flattened problem).
+    #[arg(long, default_value = "all", value_name = "POLICY")]
+    pub instance_levels: radiosity::instancing::InstanceLevels,
 }
 
 /// Values of `--instances`.
@@ -173,6 +177,7 @@ fn solve_instanced(
     config.bf.eps = args.options.eps;
     config.pipeline = args.options.config();
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
+    config.instance_levels = args.instance_levels;
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
     let stats = instancing::solve_instanced(scene, &config, &mut sink)?;

@@ -83,6 +83,8 @@ pub struct InstancedConfig {
     /// diagonal is opened in place: a closed instance receives the light as parallel beams, which
     /// misses how much brighter its near side is under a close light.
     pub open_near_emitter: f64,
+    /// Which nesting depths keep their instances closed (the rest are opened in place).
+    pub instance_levels: InstanceLevels,
     /// Budget (approximate bytes) of the levels kept for reuse: a level lit from outside is
     /// refined once and reused, solve only, for every later instance of its prototype that lies a
     /// similarity away and whose light is no brighter (see [`solve_instanced`]). 0 disables reuse.
@@ -102,6 +104,47 @@ impl Default for InstancedConfig {
             local_leaf_operator_max_entries: 250_000,
             open_near_emitter: 1.0,
             level_cache_bytes: 16_000_000,
+            instance_levels: InstanceLevels::All,
+        }
+    }
+}
+
+/// The levels to instance: which nesting depths (the scene's own instances are depth 1, theirs 2,
+/// ...) are solved as closed instances; instances at other depths are opened in place, their
+/// content joining the level above (larger local problems, fewer approximations).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum InstanceLevels {
+    /// Every depth.
+    #[default]
+    All,
+    /// Depths that are multiples of `n` (`Every(2)`: 2, 4, ...; `Every(1)` is [`InstanceLevels::All`]).
+    Every(u32),
+    /// None: the whole scene is one local problem (the flattened solve, streamed).
+    None,
+}
+
+impl InstanceLevels {
+    /// Are instances at nesting depth `depth` (≥ 1) closed?
+    #[must_use]
+    pub fn closes(self, depth: u32) -> bool {
+        match self {
+            InstanceLevels::All => true,
+            InstanceLevels::Every(n) => n > 0 && depth % n == 0,
+            InstanceLevels::None => false,
+        }
+    }
+}
+
+impl std::str::FromStr for InstanceLevels {
+    type Err = String;
+    fn from_str(s: &str) -> Result<InstanceLevels, String> {
+        match s {
+            "all" => Ok(InstanceLevels::All),
+            "none" => Ok(InstanceLevels::None),
+            _ => match s.strip_prefix("every-").and_then(|n| n.parse::<u32>().ok()) {
+                Some(n) if n >= 1 => Ok(InstanceLevels::Every(n)),
+                _ => Err(format!("`{s}` is not a level policy (all, none, every-N with N ≥ 1)")),
+            },
         }
     }
 }
@@ -218,6 +261,8 @@ struct Task {
     prototype: PrototypeId,
     transform: Transform,
     flat_base: u64,
+    /// Nesting depth of the instance (the scene is 0, its instances 1, theirs 2, ...).
+    depth: u32,
     /// The light that arrived at the instance: irradiance perpendicular to each direction of
     /// [`light_directions`] (a distant-light field); `None` at the top.
     incoming: Option<Vec<[f64; 3]>>,
@@ -256,7 +301,7 @@ fn solve_depth_first(
     let cache = config.cache_dir.as_deref().map(PropertyCache::new);
     let mut proxies: HashMap<PrototypeId, Proxy> = HashMap::new();
     let mut stats = InstancedStats::default();
-    let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, incoming: None }];
+    let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, depth: 0, incoming: None }];
     // Every local BF threshold stays relative to the scene's largest emission (see `build_level`).
     let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
     let dirs = light_directions();
@@ -266,11 +311,11 @@ fn solve_depth_first(
         // closed instances; `inlined` records which instances were opened in place (part of the
         // key under which the level is cached).
         let mut own: Vec<OwnPolygon> = Vec::new();
-        let mut closed: Vec<(PrototypeId, Transform, u64)> = Vec::new();
+        let mut closed: Vec<(PrototypeId, Transform, u64, u32)> = Vec::new();
         let mut emitters: Vec<Aabb> = Vec::new();
         let mut inlined: Vec<bool> = Vec::new();
-        let mut pending = vec![(task.prototype, task.transform, task.flat_base)];
-        while let Some((pid, t, base)) = pending.pop() {
+        let mut pending = vec![(task.prototype, task.transform, task.flat_base, task.depth)];
+        while let Some((pid, t, base, depth)) = pending.pop() {
             let p = scene.prototype(pid);
             let mut k = base;
             for q in &p.polygons {
@@ -288,14 +333,15 @@ fn solve_depth_first(
             for inst in &p.instances {
                 let c = inst.prototype;
                 let child_t = t.then(&inst.transform);
-                let open = counts[c as usize] > config.max_closed_polygons
+                let open = !config.instance_levels.closes(depth + 1)
+                    || counts[c as usize] > config.max_closed_polygons
                     || bounds[c as usize].is_empty()
                     || near_an_emitter(&child_t.aabb(&bounds[c as usize]), &emitters, config.open_near_emitter);
                 inlined.push(open);
                 if open {
-                    inline.push((c, child_t, k));
+                    inline.push((c, child_t, k, depth + 1));
                 } else {
-                    closed.push((c, child_t, k));
+                    closed.push((c, child_t, k, depth + 1));
                 }
                 k += counts[c as usize];
             }
@@ -306,7 +352,7 @@ fn solve_depth_first(
         own.sort_by_key(|o| o.2);
 
         // Properties of the closed prototypes.
-        for &(c, _, _) in &closed {
+        for &(c, _, _, _) in &closed {
             if proxies.contains_key(&c) {
                 continue;
             }
@@ -483,12 +529,12 @@ fn solve_depth_first(
         {
             levels.insert(key, level, task.transform.matrix);
         }
-        for (slot, &(c, t, base)) in closed.iter().enumerate().rev() {
+        for (slot, &(c, t, base, depth)) in closed.iter().enumerate().rev() {
             let mut field = std::mem::take(&mut fields[slot]);
             for (flux, p) in field.iter_mut().zip(&projected[slot]) {
                 *flux = flux.map(|f| if *p > 0.0 { f / p } else { 0.0 });
             }
-            stack.push(Task { prototype: c, transform: t, flat_base: base, incoming: Some(field) });
+            stack.push(Task { prototype: c, transform: t, flat_base: base, depth, incoming: Some(field) });
         }
     }
     stats.levels_cached_peak_bytes = levels.peak_bytes as u64;
@@ -616,7 +662,7 @@ fn build_level(
     scene: &InstancedScene,
     task: &Task,
     own: &[OwnPolygon],
-    closed: &[(PrototypeId, Transform, u64)],
+    closed: &[(PrototypeId, Transform, u64, u32)],
     proxies: &HashMap<PrototypeId, Proxy>,
     light: Option<OutsideLight<'_>>,
     b_ref_scene: f64,
@@ -644,7 +690,7 @@ fn build_level(
         }
     }
     let mut proxy_material: HashMap<PrototypeId, u32> = HashMap::new();
-    for (slot, &(c, t, _)) in closed.iter().enumerate() {
+    for (slot, &(c, t, _, _)) in closed.iter().enumerate() {
         let proxy = proxies[&c];
         let m = match proxy_material.get(&c) {
             Some(&m) => m,
