@@ -240,7 +240,9 @@ fn instance_level_policy_none_opens_everything_and_gives_the_full_answer() {
     let mut two = PolygonMeans::default();
     let s2 = solve_instanced(&scene, &InstancedConfig { instance_levels: InstanceLevels::Every(2), ..config() }, &mut two).unwrap();
     assert_eq!(s2.local_solves, 1);
-    let s1 = solve_instanced(&scene, &InstancedConfig { instance_levels: InstanceLevels::Every(1), ..config() }, &mut PolygonMeans::default()).unwrap();
+    let s1 =
+        solve_instanced(&scene, &InstancedConfig { instance_levels: InstanceLevels::Every(1), ..config() }, &mut PolygonMeans::default())
+            .unwrap();
     assert_eq!(s1.local_solves, 9);
     assert_eq!("every-3".parse::<InstanceLevels>(), Ok(InstanceLevels::Every(3)));
     assert!("every-0".parse::<InstanceLevels>().is_err() && "some".parse::<InstanceLevels>().is_err());

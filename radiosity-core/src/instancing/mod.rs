@@ -63,5 +63,7 @@ pub use format::{load, parse};
 pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
 pub use output::{StreamedOutput, StreamedSummary};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};
-pub use solver::{InstanceLevels, InstancedConfig, InstancedStats, Leaf, PolygonInfo, PolygonMeans, RadiositySink, solve_full, solve_instanced};
+pub use solver::{
+    InstanceLevels, InstancedConfig, InstancedStats, Leaf, PolygonInfo, PolygonMeans, RadiositySink, solve_full, solve_instanced,
+};
 pub use write::write_scene;
