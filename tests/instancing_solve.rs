@@ -247,3 +247,21 @@ fn instance_level_policy_none_opens_everything_and_gives_the_full_answer() {
     assert_eq!("every-3".parse::<InstanceLevels>(), Ok(InstanceLevels::Every(3)));
     assert!("every-0".parse::<InstanceLevels>().is_err() && "some".parse::<InstanceLevels>().is_err());
 }
+
+#[test]
+fn instances_too_close_to_each_other_are_opened_when_asked() {
+    // Two cubes of 0.4 m, 0.1 m apart along x: their boxes share 75% of their volume.
+    let mut s = String::from(ROOM);
+    s.push_str("\n[[prototype]]\nname = \"cube\"\n[[prototype.box]]\nmin = [0, 0, 0]\nmax = [0.4, 0.4, 0.4]\nmaterial = \"cube\"\n");
+    for x in [1.0, 1.1] {
+        s.push_str(&format!("\n[[instance]]\nof = \"cube\"\ntranslate = [{x}, 1.5, 1.0]\n"));
+    }
+    let scene = parse(&s);
+    let apart = solve_instanced(&scene, &config(), &mut PolygonMeans::default()).unwrap();
+    assert_eq!(apart.local_solves, 3, "by default both stay closed");
+    let close = InstancedConfig { open_overlap: 0.5, ..config() };
+    let opened = solve_instanced(&scene, &close, &mut PolygonMeans::default()).unwrap();
+    assert_eq!(opened.local_solves, 1, "both opened in place");
+    let loose = InstancedConfig { open_overlap: 0.8, ..config() };
+    assert_eq!(solve_instanced(&scene, &loose, &mut PolygonMeans::default()).unwrap().local_solves, 3, "75% is under 0.8");
+}

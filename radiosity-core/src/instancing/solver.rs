@@ -85,6 +85,12 @@ pub struct InstancedConfig {
     pub open_near_emitter: f64,
     /// Which nesting depths keep their instances closed (the rest are opened in place).
     pub instance_levels: InstanceLevels,
+    /// Instances too close to each other are opened in place: one whose box shares more than
+    /// this fraction of the smaller box's volume with a sibling's (two proxies would interpenetrate
+    /// and block each other's light twice). 1 or more disables the rule, the default: on the age-30
+    /// tree at eps 0.05 it made the answer no closer to the full solve (0.9: max error 5.62%
+    /// against 5.54%, mean 0.169% against 0.150%; 0.5: 5.89%, and 58 MB instead of 20 MB).
+    pub open_overlap: f64,
     /// Budget (approximate bytes) of the levels kept for reuse: a level lit from outside is
     /// refined once and reused, solve only, for every later instance of its prototype that lies a
     /// similarity away and whose light is no brighter (see [`solve_instanced`]). 0 disables reuse.
@@ -105,6 +111,7 @@ impl Default for InstancedConfig {
             open_near_emitter: 1.0,
             level_cache_bytes: 16_000_000,
             instance_levels: InstanceLevels::All,
+            open_overlap: 1.0,
         }
     }
 }
@@ -330,13 +337,20 @@ fn solve_depth_first(
                 }
             }
             let mut inline = Vec::new();
-            for inst in &p.instances {
+            let boxes: Vec<Aabb> = if config.open_overlap < 1.0 {
+                p.instances.iter().map(|inst| t.then(&inst.transform).aabb(&padded(&bounds[inst.prototype as usize]))).collect()
+            } else {
+                Vec::new()
+            };
+            for (i, inst) in p.instances.iter().enumerate() {
                 let c = inst.prototype;
                 let child_t = t.then(&inst.transform);
                 let open = !config.instance_levels.closes(depth + 1)
                     || counts[c as usize] > config.max_closed_polygons
                     || bounds[c as usize].is_empty()
-                    || near_an_emitter(&child_t.aabb(&bounds[c as usize]), &emitters, config.open_near_emitter);
+                    || near_an_emitter(&child_t.aabb(&bounds[c as usize]), &emitters, config.open_near_emitter)
+                    || (!boxes.is_empty()
+                        && boxes.iter().enumerate().any(|(j, b)| j != i && overlap_fraction(&boxes[i], b) > config.open_overlap));
                 inlined.push(open);
                 if open {
                     inline.push((c, child_t, k, depth + 1));
@@ -540,6 +554,23 @@ fn solve_depth_first(
     stats.levels_cached_peak_bytes = levels.peak_bytes as u64;
     stats.seconds = t0.elapsed().as_secs_f64();
     Ok(stats)
+}
+
+/// `b` with every extent at least [`MIN_PROXY_EXTENT_REL`] of its diagonal (as a proxy box is).
+fn padded(b: &Aabb) -> Aabb {
+    if b.is_empty() {
+        return *b;
+    }
+    let half = (0.5 * b.extent()).max(DVec3::splat(0.5 * MIN_PROXY_EXTENT_REL * b.diagonal()));
+    Aabb { min: b.center() - half, max: b.center() + half }
+}
+
+/// Volume of the intersection of `a` and `b` over the smaller one's volume (0 when disjoint).
+fn overlap_fraction(a: &Aabb, b: &Aabb) -> f64 {
+    let common = (a.max.min(b.max) - a.min.max(b.min)).max(DVec3::ZERO);
+    let vol = |e: DVec3| e.x * e.y * e.z;
+    let smaller = vol(a.extent()).min(vol(b.extent()));
+    if smaller > 0.0 { vol(common) / smaller } else { 0.0 }
 }
 
 /// True when box `b` lies within `rel` times its diagonal of one of the `emitters` boxes.
