@@ -136,7 +136,7 @@ impl InstanceLevels {
     pub fn closes(self, depth: u32) -> bool {
         match self {
             InstanceLevels::All => true,
-            InstanceLevels::Every(n) => n > 0 && depth % n == 0,
+            InstanceLevels::Every(n) => n > 0 && depth.is_multiple_of(n),
             InstanceLevels::None => false,
         }
     }
