@@ -291,14 +291,6 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
     props
 }
 
-pub use crate::visibility::MIN_DIRECTION_COMPONENT;
-
-/// Closest hit along a ray, with no exactly-zero direction component.
-pub(super) fn cast(caster: &RayCaster, origin: DVec3, d: DVec3) -> Option<(f64, u32)> {
-    let nudged = d.to_array().map(|x| if x.abs() < MIN_DIRECTION_COMPONENT { MIN_DIRECTION_COMPONENT.copysign(x) } else { x });
-    caster.closest_hit(origin, DVec3::from_array(nudged))
-}
-
 /// An orthonormal pair perpendicular to unit `d`.
 fn basis(d: DVec3) -> (DVec3, DVec3) {
     let helper = if d.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
@@ -367,7 +359,7 @@ fn trace_direction(flat: &Scene, caster: &RayCaster, bounds: &Aabb, w: DVec3, co
             continue;
         }
         n_box += 1;
-        match cast(caster, origin, d) {
+        match caster.closest_hit(origin, d) {
             None => n_pass += 1,
             Some((t, p)) => {
                 n_hit += 1;
@@ -413,7 +405,7 @@ fn walk(flat: &Scene, caster: &RayCaster, mut x: DVec3, mut d: DVec3, mut poly: 
         };
         d = cosine_dir(out_normal, rng);
         x += out_normal * (RAY_OFFSET_REL * diag);
-        match cast(caster, x, d) {
+        match caster.closest_hit(x, d) {
             None => return weight,
             Some((t, p)) => {
                 x += d * t;

@@ -15,6 +15,14 @@ pub const SEGMENT_END_EPS: f32 = 1e-5;
 /// components, and an exact zero can make it miss hits on faces aligned with the ray.
 pub const MIN_DIRECTION_COMPONENT: f64 = 1e-9;
 
+/// `dir` normalised for the traversal, with every component of magnitude below
+/// [`MIN_DIRECTION_COMPONENT`] (an exact zero above all) given that magnitude and its sign.
+fn ray_direction(dir: DVec3) -> Vec3A {
+    let d = dir.normalize_or_zero();
+    let nudge = |x: f64| (if x.abs() < MIN_DIRECTION_COMPONENT { MIN_DIRECTION_COMPONENT.copysign(x) } else { x }) as f32;
+    Vec3A::new(nudge(d.x), nudge(d.y), nudge(d.z))
+}
+
 /// Regularisation of the kernel weights of visibility samples, relative to the squared sum of the
 /// two elements' radii (keeps one near-contact sample from dominating).
 pub const KERNEL_REGULARISATION: f64 = 1e-4;
@@ -138,15 +146,14 @@ impl RayCaster {
         })
     }
 
-    /// Closest hit along a ray in scene coordinates: `(distance, input polygon)`.
+    /// Closest hit along a ray in scene coordinates: `(distance, input polygon)`. Direction
+    /// components that are exactly zero are nudged (see [`ray_direction`]).
     #[must_use]
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<(f64, u32)> {
         if self.triangles.is_empty() {
             return None;
         }
-        let o = self.to_local(origin);
-        let d = dir.normalize_or_zero();
-        let ray = Ray::new(o, Vec3A::new(d.x as f32, d.y as f32, d.z as f32), 0.0, f32::INFINITY);
+        let ray = Ray::new(self.to_local(origin), ray_direction(dir), 0.0, f32::INFINITY);
         let mut hit = obvhs::ray::RayHit::none();
         if self.bvh.ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray)) {
             Some((hit.t as f64 / self.inv_scale, self.tri_polygon[hit.primitive_id as usize]))
@@ -157,16 +164,14 @@ impl RayCaster {
 
     /// True when the ray from `origin` along `dir` (scene coordinates) meets no triangle: an
     /// occlusion query, cheaper than [`RayCaster::closest_hit`]. Direction components that are
-    /// exactly zero are nudged to a tiny value of the same sign (the traversal divides by them).
+    /// exactly zero are nudged (see [`ray_direction`]).
     #[must_use]
     pub fn ray_clear(&self, origin: DVec3, dir: DVec3) -> bool {
         self.rays_cast.fetch_add(1, Ordering::Relaxed);
         if self.triangles.is_empty() {
             return true;
         }
-        let d = dir.normalize_or_zero();
-        let nudge = |x: f64| if x.abs() < MIN_DIRECTION_COMPONENT { MIN_DIRECTION_COMPONENT.copysign(x) } else { x };
-        let ray = Ray::new(self.to_local(origin), Vec3A::new(nudge(d.x) as f32, nudge(d.y) as f32, nudge(d.z) as f32), 0.0, f32::INFINITY);
+        let ray = Ray::new(self.to_local(origin), ray_direction(dir), 0.0, f32::INFINITY);
         self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
     }
 
