@@ -282,6 +282,11 @@ enum Role {
     ProxyFace { slot: usize },
 }
 
+/// Is polygon `i` of a level with `roles` a proxy face? (False past the end.)
+fn is_proxy(roles: &[Role], i: usize) -> bool {
+    matches!(roles.get(i), Some(Role::ProxyFace { .. }))
+}
+
 /// Solves `scene` depth-first with instances (see the module docs), streaming every finished
 /// flattened polygon to `sink`.
 pub fn solve_instanced(
@@ -416,7 +421,7 @@ fn solve_depth_first(
         let rotation = similarity.as_ref().map_or(DMat3::IDENTITY, |s: &Similarity| s.rotation);
         let dirs_level: Vec<DVec3> = dirs.iter().map(|d| rotation.transpose() * *d).collect();
         let (external, external_bins) = match (&task.incoming, &level.table) {
-            (Some(field), Some(table)) => table_irradiance(&level.polys, table, &dirs_level, field, &level.is_proxy),
+            (Some(field), Some(table)) => table_irradiance(&level.polys, table, &dirs_level, field, &level.roles),
             _ => (Vec::new(), Vec::new()),
         };
         let solution = match level.solution.take() {
@@ -506,7 +511,7 @@ fn solve_depth_first(
         // its share of the beams from outside, as a field per closed instance. Two passes over the
         // links (per-face totals, then shares), so that no per-face field is ever held.
         let mut face_total = vec![[0.0; 3]; level.polys.len()];
-        for_each_link_direction(h, &level.links, &solution.radiosity, &level.is_proxy, &dirs_level, |face, _, w| {
+        for_each_link_direction(h, &level.links, &solution.radiosity, &level.roles, &dirs_level, |face, _, w| {
             for c in 0..3 {
                 face_total[face][c] += w[c];
             }
@@ -528,7 +533,7 @@ fn solve_depth_first(
                 }
             }
         }
-        for_each_link_direction(h, &level.links, &solution.radiosity, &level.is_proxy, &dirs_level, |face, b, w| {
+        for_each_link_direction(h, &level.links, &solution.radiosity, &level.roles, &dirs_level, |face, b, w| {
             let Role::ProxyFace { slot } = level.roles[face] else { return };
             let area = level.polys[face].area();
             for c in 0..3 {
@@ -556,13 +561,20 @@ fn solve_depth_first(
     Ok(stats)
 }
 
-/// `b` with every extent at least [`MIN_PROXY_EXTENT_REL`] of its diagonal (as a proxy box is).
+/// Centre and half-extents of `b` with every extent at least [`MIN_PROXY_EXTENT_REL`] of its
+/// diagonal: the box a proxy is shrunk from.
+fn padded_half(b: &Aabb) -> (DVec3, DVec3) {
+    let min_extent = MIN_PROXY_EXTENT_REL * b.diagonal().max(f64::MIN_POSITIVE);
+    (b.center(), (0.5 * b.extent()).max(DVec3::splat(0.5 * min_extent)))
+}
+
+/// `b` padded as a proxy's box is (see [`padded_half`]).
 fn padded(b: &Aabb) -> Aabb {
     if b.is_empty() {
         return *b;
     }
-    let half = (0.5 * b.extent()).max(DVec3::splat(0.5 * MIN_PROXY_EXTENT_REL * b.diagonal()));
-    Aabb { min: b.center() - half, max: b.center() + half }
+    let (c, half) = padded_half(b);
+    Aabb { min: c - half, max: c + half }
 }
 
 /// Volume of the intersection of `a` and `b` over the smaller one's volume (0 when disjoint).
@@ -611,7 +623,7 @@ fn for_each_link_direction(
     h: &Hierarchy,
     links: &[crate::refine::Link],
     radiosity: &[[f64; 3]],
-    is_proxy: &[bool],
+    roles: &[Role],
     dirs: &[DVec3],
     mut f: impl FnMut(usize, usize, [f64; 3]),
 ) {
@@ -621,7 +633,7 @@ fn for_each_link_direction(
         match r.kind {
             crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
                 for &p in &h.cluster_polygons[poly_start as usize..poly_end as usize] {
-                    if !is_proxy.get(p as usize).copied().unwrap_or(false) {
+                    if !is_proxy(roles, p as usize) {
                         continue;
                     }
                     let face = h.get(p);
@@ -634,7 +646,7 @@ fn for_each_link_direction(
             }
             _ => {
                 let Some(p) = r.polygon() else { continue };
-                if is_proxy.get(p as usize).copied().unwrap_or(false) {
+                if is_proxy(roles, p as usize) {
                     let u = (src.center - r.center).normalize_or_zero();
                     f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x));
                 }
@@ -650,8 +662,6 @@ struct Level {
     polys: Vec<Poly>,
     /// What each polygon stands for (flattened indices relative to the instance's first).
     roles: Vec<Role>,
-    /// Proxy faces.
-    is_proxy: Vec<bool>,
     /// Emission of each polygon, light from outside the level excluded.
     base_emission: Vec<[f64; 3]>,
     /// The refined hierarchy (its emission is rewritten for every instance).
@@ -772,7 +782,6 @@ fn build_level(
     }
     let solved = pipeline::run(&local, &BfHand { params: bf }, &local_pipeline(config), &|_| {});
     Ok(Some(Level {
-        is_proxy: roles.iter().map(|r| matches!(r, Role::ProxyFace { .. })).collect(),
         polys,
         roles,
         base_emission,
@@ -978,14 +987,14 @@ impl VisibilityTable {
 
 /// Irradiance from outside of every polygon of a level (see the module docs): `field` is the
 /// irradiance perpendicular to each beam of `dirs` (taken into the level's frame), received where
-/// the table says the beam's direction leaves the level. For polygons marked in `keep_bins`, the
+/// the table says the beam's direction leaves the level. For the proxy faces among `roles`, the
 /// share of each beam is returned too.
 fn table_irradiance(
     polys: &[Poly],
     table: &VisibilityTable,
     dirs: &[DVec3],
     field: &[[f64; 3]],
-    keep_bins: &[bool],
+    roles: &[Role],
 ) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>) {
     let strongest = field.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max);
     let active: Vec<usize> =
@@ -997,7 +1006,7 @@ fn table_irradiance(
         .enumerate()
         .map(|(i, p)| {
             let n = p.normal();
-            let keep = keep_bins.get(i).copied().unwrap_or(false);
+            let keep = is_proxy(roles, i);
             let mut bins = if keep { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
             let mut acc = [0.0; 3];
             for &b in &active {
@@ -1021,9 +1030,7 @@ fn table_irradiance(
 }
 
 fn proxy_of(local: &Aabb, props: &RadiativeProperties) -> Proxy {
-    let c = local.center();
-    let min_extent = MIN_PROXY_EXTENT_REL * local.diagonal().max(f64::MIN_POSITIVE);
-    let half = (0.5 * local.extent()).max(DVec3::splat(0.5 * min_extent));
+    let (c, half) = padded_half(local);
     let s = (1.0 - props.mean_transmittance()).clamp(0.0, 1.0).sqrt().max(MIN_PROXY_EXTENT_REL);
     Proxy { shrunk: Aabb { min: c - half * s, max: c + half * s }, albedo: props.mean_albedo() }
 }

@@ -225,8 +225,7 @@ impl<'a> Operator<'a> {
         if self.through.is_empty() {
             return;
         }
-        let flat: Vec<f64> = leaf_h.iter().flatten().copied().collect();
-        let mean = self.pull(&flat);
+        let mean = self.pull(leaf_h.as_flattened());
         for (i, &(t, q)) in self.through.iter().enumerate() {
             if q != NONE {
                 for k in 0..3 {
