@@ -59,7 +59,6 @@ fn duplex_agrees_with_plain_rays() {
 fn the_shaft_oracle_gets_shafts_from_a_default_pipeline() {
     use radiosity::oracle::registry;
     use radiosity::pipeline::{self, Config, VisibilityMethod};
-    use radiosity::refine::Oracle;
     let shaft = registry::oracle("shaft", &[]).unwrap();
     let bf = registry::oracle("bf", &[]).unwrap();
     assert!(shaft.needs().shafts);

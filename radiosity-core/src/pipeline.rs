@@ -209,7 +209,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     }
     let solution = solution.expect("at least one pass solves");
     let t = Instant::now();
-    let (solution, more_iterations, leaf_entries) = finish_solve(&h, &links, solution, config, progress, passes);
+    let (solution, more_iterations, leaf_entries) = finish_solve(&h, &links, solution, config, progress, passes, &mut None);
     iterations += more_iterations;
     timings.solve += t.elapsed().as_secs_f64();
     let error_estimate = config.estimate_error.then(|| solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
@@ -246,27 +246,21 @@ pub fn effective_visibility(oracle: &dyn Oracle, requested: VisibilityMethod) ->
 
 /// Solves the radiosity system of links already refined, with the emission now in `h` (a level of
 /// the instanced solver reuses one refinement for every instance of a prototype): the
-/// hierarchical solve, then the leaf-resolution solve or gather of [`Config::final_gather`]. The
-/// leaf-resolution coefficients are taken from `leaf` when given (computed before for the same
-/// hierarchy and links). Returns the solution, the iterations and the leaf-operator entries (0
-/// when gathered).
+/// hierarchical solve, then the leaf-resolution solve or gather of [`Config::final_gather`]. `leaf`
+/// keeps the leaf-resolution coefficients between calls for the same hierarchy and links (computed
+/// at the first call when within [`Config::leaf_operator_max_entries`]). Returns the solution, the
+/// iterations and the leaf-operator entries (0 when gathered).
 #[must_use]
-pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: Option<&solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
+pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
     let sol = solve::solve(h, links, &initial_radiosity(h), &config.solve);
-    let iterations = sol.iterations;
-    let (sol, more, entries) = match leaf {
-        Some(coefficients) if config.final_gather => {
-            let op = solve::LeafOperator::with_coefficients(h, links, coefficients);
-            let sol = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
-            let more = sol.iterations;
-            (sol, more, coefficients.entries())
-        }
-        _ => finish_solve(h, links, sol, config, &|_| {}, 1),
-    };
-    (sol, iterations + more, entries)
+    let first = sol.iterations;
+    let (sol, more, entries) = finish_solve(h, links, sol, config, &|_| {}, 1, leaf);
+    (sol, first + more, entries)
 }
 
-/// The final gather step after the hierarchical solve: `(solution, iterations, leaf entries)`.
+/// The final gather step after the hierarchical solve, with the leaf-resolution coefficients of
+/// `leaf` (computed and kept there when absent and within budget): `(solution, iterations, leaf
+/// entries)`.
 fn finish_solve(
     h: &Hierarchy,
     links: &[Link],
@@ -274,25 +268,33 @@ fn finish_solve(
     config: &Config,
     progress: &dyn Fn(Progress),
     passes: usize,
+    leaf: &mut Option<solve::LeafCoefficients>,
 ) -> (Solution, usize, usize) {
-    let mut iterations = 0;
-    let mut leaf_entries = 0;
-    if config.final_gather {
-        leaf_entries = solve::leaf_operator_entries(h, links);
-        if leaf_entries <= config.leaf_operator_max_entries {
-            progress(Progress::LeafSolve { entries: leaf_entries });
-            let sol = solve::solve_leaf(h, links, &solution.radiosity, &config.solve);
-            iterations += sol.iterations;
+    if !config.final_gather {
+        return (solution, 0, 0);
+    }
+    if leaf.is_none() {
+        let entries = solve::leaf_operator_entries(h, links);
+        if entries <= config.leaf_operator_max_entries {
+            progress(Progress::LeafSolve { entries });
+            *leaf = Some(solve::LeafCoefficients::new(h, links));
+        }
+    }
+    match leaf {
+        Some(coefficients) => {
+            let op = solve::LeafOperator::new(h, links, coefficients);
+            let sol = solve::solve_leaf_operator(&op, &solution.radiosity, &config.solve);
             progress(Progress::Solved { pass: passes + 1, iterations: sol.iterations, residual: sol.residual });
-            solution = sol;
-        } else {
+            let iterations = sol.iterations;
+            (sol, iterations, coefficients.entries())
+        }
+        None => {
             let (b, irr) = solve::final_gather(h, links, &solution.radiosity);
             solution.radiosity = b;
             solution.irradiance = irr;
-            leaf_entries = 0;
+            (solution, 0, 0)
         }
     }
-    (solution, iterations, leaf_entries)
 }
 
 /// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene

@@ -437,14 +437,7 @@ fn solve_depth_first(
                         level.base_emission[i][c] + h.reflectance[i][c] * ext[c] + h.transmittance[i][c] * other[c]
                     });
                 }
-                let pipeline_config = local_pipeline(config);
-                if level.leaf.is_none()
-                    && pipeline_config.final_gather
-                    && crate::solve::leaf_operator_entries(&level.h, &level.links) <= pipeline_config.leaf_operator_max_entries
-                {
-                    level.leaf = Some(crate::solve::LeafCoefficients::new(&level.h, &level.links));
-                }
-                let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, level.leaf.as_ref(), &pipeline_config);
+                let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, &mut level.leaf, &local_pipeline(config));
                 level.iterations = iterations;
                 solution
             }
@@ -670,7 +663,8 @@ struct Level {
     links: Vec<Link>,
     /// Visibility of the table's directions from each polygon (levels lit from outside).
     table: Option<VisibilityTable>,
-    /// Leaf-resolution coefficients, computed at the first solve of a level lit from outside.
+    /// Leaf-resolution coefficients, kept by [`pipeline::solve_links`] from the first solve of a
+    /// level lit from outside.
     leaf: Option<crate::solve::LeafCoefficients>,
     /// The solution of a level with no light from outside (the top), solved while refining.
     solution: Option<Solution>,

@@ -23,7 +23,7 @@ pub const LEAF_OPERATOR_MAX_ENTRIES: usize = 40_000_000;
 /// Per-leaf gather lists over the chain of ancestor links.
 pub struct LeafOperator<'a> {
     op: Operator<'a>,
-    lists: std::borrow::Cow<'a, LeafCoefficients>,
+    lists: &'a LeafCoefficients,
 }
 
 /// The coefficients of a [`LeafOperator`]: geometry only (form factors and visibility), so they
@@ -148,17 +148,11 @@ impl<'l> LinksByReceiver<'l> {
 }
 
 impl<'a> LeafOperator<'a> {
-    /// Builds the per-leaf lists, evaluating `link_form_factor(source, leaf)` for ancestor links.
+    /// The operator of `h` and `links` with coefficients computed by [`LeafCoefficients::new`] for
+    /// the same hierarchy and links (the emission may have changed since).
     #[must_use]
-    pub fn new(h: &'a Hierarchy, links: &[Link]) -> LeafOperator<'a> {
-        LeafOperator { op: Operator::new(h, links), lists: std::borrow::Cow::Owned(LeafCoefficients::new(h, links)) }
-    }
-
-    /// The operator of `h` and `links` with coefficients computed before by
-    /// [`LeafCoefficients::new`] for the same hierarchy and links (the emission may differ).
-    #[must_use]
-    pub fn with_coefficients(h: &'a Hierarchy, links: &[Link], coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
-        LeafOperator { op: Operator::new(h, links), lists: std::borrow::Cow::Borrowed(coefficients) }
+    pub fn new(h: &'a Hierarchy, links: &[Link], coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
+        LeafOperator { op: Operator::new(h, links), lists: coefficients }
     }
 
     /// The hierarchical operator underneath (leaf order, pull, emission).
@@ -177,7 +171,7 @@ impl<'a> LeafOperator<'a> {
     #[must_use]
     pub fn gather_leaves(&self, x: &[f64]) -> Vec<[f64; 3]> {
         let b = self.op.pull(x);
-        let l = &*self.lists;
+        let l = self.lists;
         (0..self.op.leaves().len())
             .into_par_iter()
             .map(|i| {

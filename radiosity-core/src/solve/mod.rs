@@ -62,14 +62,8 @@ pub fn solve(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &Solve
     Solution { radiosity, irradiance, iterations: result.iterations, residual: result.residual, converged: result.converged }
 }
 
-/// Solves the leaf-resolution system ([`LeafOperator`]) starting from `initial` (per element, usually
-/// the hierarchical solution).
-#[must_use]
-pub fn solve_leaf(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &SolveConfig) -> Solution {
-    solve_leaf_operator(&LeafOperator::new(h, links), initial, config)
-}
-
-/// Solves the system of a leaf operator built before (see [`LeafOperator::with_coefficients`]).
+/// Solves the leaf-resolution system of `op` ([`LeafOperator`]) starting from `initial` (per
+/// element, usually the hierarchical solution).
 #[must_use]
 pub fn solve_leaf_operator(op: &LeafOperator<'_>, initial: &[[f64; 3]], config: &SolveConfig) -> Solution {
     let rhs = op.hierarchical().emission();
