@@ -1071,35 +1071,33 @@ pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(P
     Ok((means, solved.links.len() as u64))
 }
 
+/// Per polygon of `reference`: its error in `approx` (largest over the channels) as a fraction of
+/// the largest radiosity of `reference`, and its area.
+fn polygon_errors<'a>(reference: &'a PolygonMeans, approx: &'a PolygonMeans) -> impl Iterator<Item = (f64, f64)> + 'a {
+    let b_max = reference.radiosity.iter().flat_map(|b| b.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    reference.radiosity.iter().enumerate().map(move |(i, r)| {
+        let a = approx.radiosity.get(i).copied().unwrap_or([0.0; 3]);
+        let e = (0..3).map(|c| (r[c] - a[c]).abs()).fold(0.0, f64::max);
+        (e / b_max, reference.area.get(i).copied().unwrap_or(0.0))
+    })
+}
+
 /// Polygons of `approx` whose error (largest over the channels) exceeds `fraction` of the largest
 /// radiosity of `reference`.
 #[must_use]
 pub fn polygons_above(reference: &PolygonMeans, approx: &PolygonMeans, fraction: f64) -> usize {
-    let b_max = reference.radiosity.iter().flat_map(|b| b.iter().copied()).fold(0.0, f64::max);
-    reference
-        .radiosity
-        .iter()
-        .enumerate()
-        .filter(|(i, r)| {
-            let a = approx.radiosity.get(*i).copied().unwrap_or([0.0; 3]);
-            (0..3).any(|c| (r[c] - a[c]).abs() > fraction * b_max)
-        })
-        .count()
+    polygon_errors(reference, approx).filter(|&(e, _)| e > fraction).count()
 }
 
 /// Error of `approx` against `reference`, per polygon and channel, as a fraction of the largest
 /// radiosity of `reference`: `(max error, area-weighted mean error)`.
 #[must_use]
 pub fn relative_error(reference: &PolygonMeans, approx: &PolygonMeans) -> (f64, f64) {
-    let b_max = reference.radiosity.iter().flat_map(|b| b.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let (mut worst, mut acc, mut area) = (0.0f64, 0.0, 0.0);
-    for (i, r) in reference.radiosity.iter().enumerate() {
-        let a = approx.radiosity.get(i).copied().unwrap_or([0.0; 3]);
-        let e = (0..3).map(|c| (r[c] - a[c]).abs()).fold(0.0, f64::max);
+    for (e, w) in polygon_errors(reference, approx) {
         worst = worst.max(e);
-        let w = reference.area.get(i).copied().unwrap_or(0.0);
         acc += w * e;
         area += w;
     }
-    (worst / b_max, if area > 0.0 { acc / area / b_max } else { 0.0 })
+    (worst, if area > 0.0 { acc / area } else { 0.0 })
 }
