@@ -317,8 +317,10 @@ fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
     for p in 0..n {
         b[p] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * ambient[c]);
     }
-    // Clusters: area-weighted means, children before parents (clusters were created after their children).
-    for e in n..h.len() {
+    // Clusters: area-weighted means, children before parents. The build reserves a cluster's slot
+    // before building its children (pre-order), so every descendant of a cluster has a larger id:
+    // going down the ids reaches the children first.
+    for e in (n..h.len()).rev() {
         let el = h.get(e as u32);
         if el.is_cluster() {
             let mut acc = [0.0; 3];
@@ -332,4 +334,32 @@ fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
         }
     }
     b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every cluster's first guess is the area-weighted mean of its polygons' (a cluster's children
+    /// are built after it, so a pass in id order would average children not yet set).
+    #[test]
+    fn initial_radiosity_of_clusters_is_the_mean_of_their_polygons() {
+        let scene = crate::scene::cornell_box();
+        let h = hierarchy::build(&scene, &hierarchy::BuildConfig { max_leaf_polygons: 2, ..Default::default() });
+        let b = initial_radiosity(&h);
+        let mut clusters = 0;
+        for e in 0..h.len() as u32 {
+            let crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } = h.get(e).kind else { continue };
+            let members = &h.cluster_polygons[poly_start as usize..poly_end as usize];
+            let area: f64 = members.iter().map(|&p| h.get(p).area).sum();
+            for c in 0..3 {
+                let mean = members.iter().map(|&p| h.get(p).area * b[p as usize][c]).sum::<f64>() / area;
+                assert!((b[e as usize][c] - mean).abs() <= 1e-12 * mean.abs().max(1e-300), "cluster {e}: {} vs {mean}", b[e as usize][c]);
+            }
+            clusters += 1;
+        }
+        assert!(clusters > 3 && h.get(h.root).is_cluster(), "the test needs nested clusters");
+        let top = b[h.root as usize];
+        assert!(top.iter().all(|&x| x > 0.0), "the root of a lit scene has a positive first guess: {top:?}");
+    }
 }
