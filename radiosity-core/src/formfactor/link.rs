@@ -70,6 +70,14 @@ pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: Form
         return cluster_ff(h, s, r, false);
     };
     let sv = sp.vertices();
+    // A receiver on or behind the source's plane, or a source on or behind the receiver's, gets
+    // nothing. Coplanar back-to-back pairs (a face flush against a wall) would otherwise reach the
+    // contour integral with every receiver point in the source's plane, where it is undefined
+    // (it returned the clamp, 1): the leaf-resolution gather evaluates such pairs when a link to a
+    // cluster holding the face was accepted for the cluster's other members.
+    if behind_plane(sp, s.normal, s.radius, rp) || behind_plane(rp, r.normal, r.radius, sp) {
+        return 0.0;
+    }
     if quality == FormFactorQuality::Estimate {
         return point_polygon(r.center, r.normal, sv, s.normal);
     }
@@ -166,6 +174,17 @@ fn rule_average(rp: &Poly, rn: DVec3, sv: &[DVec3], sn: DVec3, rule: &quadrature
     f
 }
 
+/// Relative tolerance (times the plane polygon's radius) within which a vertex counts as on a
+/// plane in [`link_form_factor`]'s facing test.
+pub const ON_PLANE_REL_TOL: f64 = 1e-9;
+
+/// Whether every vertex of `other` lies on or behind the plane of `plane` (normal `normal`).
+fn behind_plane(plane: &Poly, normal: DVec3, radius: f64, other: &Poly) -> bool {
+    let origin = plane.v[0];
+    let tol = ON_PLANE_REL_TOL * radius;
+    other.vertices().iter().all(|v| normal.dot(*v - origin) <= tol)
+}
+
 /// Clusters with at most this many polygons use their members' exact projected area in the link
 /// direction; larger ones the isotropic `A/4`.
 pub const CLUSTER_EXACT_MAX_POLYGONS: usize = 1024;
@@ -258,5 +277,37 @@ mod tests {
         let g = brute(0.0, 1.0, &tri, tn);
         assert!(g > 1e-3, "the configuration exchanges light: {g}");
         assert!((f - g).abs() < 2e-3 * g, "clipped contour {f} vs quadrature {g}");
+    }
+
+    /// A face flush against a wall, back to back (same plane, opposite normals), exchanges nothing
+    /// with it, and neither does a face behind another; a facing pair does. Before the facing test
+    /// the contour integral returned its clamp, 1, for the back-to-back pair.
+    #[test]
+    fn back_to_back_and_behind_pairs_get_nothing() {
+        use crate::scene::{Material, SceneBuilder};
+        let mut b = SceneBuilder::new(std::path::Path::new("test"), "test");
+        let m = b.material(Material::diffuse("grey", [0.5; 3])).unwrap();
+        let g = b.group("g");
+        let wall = [DVec3::new(0., 0., 0.), DVec3::new(2., 0., 0.), DVec3::new(2., 0., 2.), DVec3::new(0., 0., 2.)];
+        // The wall faces +y; the flush face (wound the other way) faces −y, as do the others.
+        let flush: Vec<DVec3> =
+            [DVec3::new(0.5, 0., 0.5), DVec3::new(0.5, 0., 1.5), DVec3::new(1.5, 0., 1.5), DVec3::new(1.5, 0., 0.5)].to_vec();
+        let facing: Vec<DVec3> =
+            [DVec3::new(0.5, 1., 0.5), DVec3::new(0.5, 1., 1.5), DVec3::new(1.5, 1., 1.5), DVec3::new(1.5, 1., 0.5)].to_vec();
+        let behind: Vec<DVec3> = facing.iter().map(|v| DVec3::new(v.x, -1.0, v.z)).collect();
+        for poly in [&wall[..], &flush, &facing, &behind] {
+            let reversed: Vec<DVec3> = poly.iter().rev().copied().collect();
+            b.face(&reversed, m, g, 0).unwrap();
+        }
+        let scene = b.finish();
+        let h = crate::hierarchy::build(&scene, &crate::hierarchy::BuildConfig::default());
+        let n = |i: u32| h.get(i).normal;
+        assert!(n(0).y > 0.99 && n(1).y < -0.99 && n(2).y < -0.99, "normals {} {} {}", n(0), n(1), n(2));
+        for q in [FormFactorQuality::Estimate, FormFactorQuality::Precise] {
+            assert_eq!(link_form_factor(&h, 0, 1, q), 0.0, "wall -> flush face");
+            assert_eq!(link_form_factor(&h, 1, 0, q), 0.0, "flush face -> wall");
+            assert_eq!(link_form_factor(&h, 0, 3, q), 0.0, "wall -> face behind it");
+            assert!(link_form_factor(&h, 0, 2, q) > 0.05, "wall -> face in front of it");
+        }
     }
 }
