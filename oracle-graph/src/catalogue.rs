@@ -159,6 +159,14 @@ pub const BUILTIN_TOOLS: &[ToolInfo] = &[
         doc: "which element is larger by bounding radius (ties: the emitter)",
     },
     ToolInfo {
+        name: "SplitFirst",
+        kind: ToolKind::Question,
+        answers: &["Emitter", "Receiver"],
+        args: &[],
+        slots: &[],
+        doc: "which element to subdivide first: a cluster before a surface when apart, else the larger by bounding radius",
+    },
+    ToolInfo {
         name: "PlanesIntersect",
         kind: ToolKind::Question,
         answers: YES_NO,

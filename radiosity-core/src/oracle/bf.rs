@@ -2,7 +2,8 @@
 //! by `oracle!` ([`BfFlat`]) and interpreted by the DAG runtime ([`bf_dag`], from [`BF_TOML`]).
 //! The three make the same decisions (the equivalence tests compare links and radiosity bit for
 //! bit): facing pairs only; link when `B_S · F_max ≤ eps · B_ref`;
-//! otherwise subdivide what can be, the larger element first.
+//! otherwise subdivide what can be: a cluster before a surface apart from it, else the larger
+//! element first.
 
 use super::runtime::{DagOracle, GraphFileError, parse_graph};
 use std::path::Path;
@@ -20,9 +21,9 @@ oracle_macros::oracle! {
             Neither => link,
             Emitter => subdivide_emitter,
             Receiver => subdivide_receiver,
-            Both => larger,
+            Both => first,
         }
-        larger: Larger { Emitter => subdivide_emitter, Receiver => subdivide_receiver }
+        first: SplitFirst { Emitter => subdivide_emitter, Receiver => subdivide_receiver }
     }
 }
 
@@ -63,12 +64,12 @@ arms = [
     { on = "Neither", to = "link" },
     { on = "Emitter", to = "subdivide_emitter" },
     { on = "Receiver", to = "subdivide_receiver" },
-    { on = "Both", to = "larger" },
+    { on = "Both", to = "first" },
 ]
 
 [[node]]
-name = "larger"
-tool = "Larger"
+name = "first"
+tool = "SplitFirst"
 arms = [{ on = "Emitter", to = "subdivide_emitter" }, { on = "Receiver", to = "subdivide_receiver" }]
 "#;
 

@@ -81,8 +81,8 @@ oracle_macros::oracle! {
             Neither => link,
             Emitter => subdivide_emitter,
             Receiver => subdivide_receiver,
-            Both => larger,
+            Both => first,
         }
-        larger: Larger { Emitter => subdivide_emitter, Receiver => subdivide_receiver }
+        first: SplitFirst { Emitter => subdivide_emitter, Receiver => subdivide_receiver }
     }
 }

@@ -35,8 +35,8 @@ impl Oracle for BfHand {
 
 /// The BF decision: drop pairs that cannot see each other's front; link when `B_S · F_max` (the
 /// largest point form factor over the receiver, estimated) is below
-/// `eps · B_ref`; otherwise subdivide the larger element (by bounding radius), or the other one when
-/// the larger cannot be subdivided, or link when neither can.
+/// `eps · B_ref`; otherwise subdivide the element [`emitter_first`] picks, or the other one when
+/// that cannot be subdivided, or link when neither can.
 pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
     if !ctx.facing() {
         return Decision::Stop;
@@ -58,11 +58,29 @@ pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
         (true, false) => Decision::SubdivideEmitter,
         (false, true) => Decision::SubdivideReceiver,
         (true, true) => {
-            if s.radius >= r.radius {
+            if emitter_first(s, r) {
                 Decision::SubdivideEmitter
             } else {
                 Decision::SubdivideReceiver
             }
         }
     }
+}
+
+/// Which end of a link to subdivide first: between a cluster and a surface whose bounding spheres
+/// are apart, the cluster; otherwise the larger by bounding radius (ties: the emitter). True for
+/// the emitter.
+///
+/// A cluster first because splitting a far surface against a cluster gains nothing where the error
+/// is: a lamp split into pieces, each linked to a tree crown, hands every leaf the visibility
+/// averaged over the crown in as many links as there are pieces, and the errors add up instead of
+/// averaging out. On a generated 30-year tree (eps 0.05) 963 of 25,980 sampled leaves came out
+/// below the ray-traced direct light they receive (a lower bound on their radiosity), by up to 6.5%
+/// of the largest radiosity; splitting the crown first left none (largest shortfall 0.7%, the
+/// sampling noise of the bound). Near pairs keep the size rule: there a cluster split into surfaces
+/// meets the contact refinement that the cluster estimate had bounded.
+#[must_use]
+pub fn emitter_first(s: &crate::hierarchy::Element, r: &crate::hierarchy::Element) -> bool {
+    let apart = (s.center - r.center).length() > s.radius + r.radius;
+    if apart && s.is_cluster() != r.is_cluster() { s.is_cluster() } else { s.radius >= r.radius }
 }

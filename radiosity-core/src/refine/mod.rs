@@ -6,7 +6,7 @@ mod bf_hand;
 mod context;
 mod driver;
 
-pub use bf_hand::{BfHand, BfParams};
+pub use bf_hand::{BfHand, BfParams, emitter_first};
 pub use context::{LinkCtx, LinkData, Services, ShaftServices};
 pub use driver::{Link, RefineStats, refine};
 

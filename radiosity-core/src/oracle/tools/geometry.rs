@@ -113,6 +113,19 @@ impl Tool for Larger {
     }
 }
 
+/// Which element to subdivide first: a cluster before a surface when they are apart, otherwise
+/// the larger by bounding radius (ties: the emitter); see [`crate::refine::emitter_first`].
+#[derive(Clone, Copy, Debug)]
+pub struct SplitFirst;
+
+impl Tool for SplitFirst {
+    type Answer = Side;
+    #[inline]
+    fn ask(&self, ctx: &mut LinkCtx<'_>) -> Side {
+        if crate::refine::emitter_first(ctx.emitter_element(), ctx.receiver_element()) { Side::Emitter } else { Side::Receiver }
+    }
+}
+
 /// Relative tolerance (times the plane element's radius) within which a vertex counts as on a plane.
 pub const PLANE_REL_TOL: f64 = 1e-9;
 

@@ -9,6 +9,7 @@ mod visibility;
 pub use command::{Done, Mark, PreciseFormFactor, PreciseVisibility};
 pub use energy::{BfAbove, FfGradient, FfSpread, Irradiance, IrradianceChange};
 pub use geometry::{
-    CanSubdivide, ClusterTooNear, Cone, Facing, Larger, NormalCone, PlanesIntersect, ProjectedAreaBelow, Side, Subdividable, YesNo,
+    CanSubdivide, ClusterTooNear, Cone, Facing, Larger, NormalCone, PlanesIntersect, ProjectedAreaBelow, Side, SplitFirst, Subdividable,
+    YesNo,
 };
 pub use visibility::{PROBABLE_BELOW_RAYS, REFERENCE_RAYS, RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};
