@@ -279,6 +279,31 @@ impl InstancedScene {
         counts
     }
 
+    /// Flattened surface area of every prototype (two-sided surfaces counted twice with
+    /// `two_sided_pairs`, as the solver sees them). An instance's area scales by `|det|^(2/3)` of
+    /// its transform's linear part: exact for similarities (rotation, uniform scale, translation),
+    /// which is what generated and automatically found instances use; an approximation under shear
+    /// or non-uniform scale.
+    #[must_use]
+    pub fn flattened_areas(&self, two_sided_pairs: bool) -> Vec<f64> {
+        let mut areas = vec![0.0f64; self.prototypes.len()];
+        for id in self.bottom_up() {
+            let p = &self.prototypes[id as usize];
+            let own: f64 = p
+                .polygons
+                .iter()
+                .map(|q| q.poly.area() * if two_sided_pairs && self.materials[q.material as usize].two_sided { 2.0 } else { 1.0 })
+                .sum();
+            let sub: f64 = p
+                .instances
+                .iter()
+                .map(|i| areas[i.prototype as usize] * glam::DMat3::from_mat4(i.transform.matrix).determinant().abs().powf(2.0 / 3.0))
+                .sum();
+            areas[id as usize] = own + sub;
+        }
+        areas
+    }
+
     /// Local bounding box of every prototype (its own polygons and its instances' boxes).
     #[must_use]
     pub fn local_bounds(&self) -> Vec<Aabb> {

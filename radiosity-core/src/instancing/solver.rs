@@ -316,6 +316,10 @@ fn solve_depth_first(
     let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, depth: 0, incoming: None }];
     // Every local BF threshold stays relative to the scene's largest emission (see `build_level`).
     let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
+    // The smallest element is as large in every local problem as in the flattened solve (its
+    // relative minimum times the whole scene's area), not relative to the small area of a twig,
+    // which let a twig's leaves split ten thousand times finer than the full solve splits them.
+    let min_area = config.pipeline.build.min_area_rel * scene.flattened_areas(true)[scene.root as usize];
     let dirs = light_directions();
     let mut levels = LevelCache::new(config.level_cache_bytes);
     while let Some(task) = stack.pop() {
@@ -402,7 +406,7 @@ fn solve_depth_first(
         let mut fresh = None;
         if reused.is_none() {
             let light = task.incoming.as_deref().zip(class).map(|(field, (_, raise))| OutsideLight { dirs: &dirs, field, raise });
-            let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, b_ref_scene, config)? else { continue };
+            let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, (b_ref_scene, min_area), config)? else { continue };
             fresh = Some(level);
         }
         drop(own);
@@ -700,7 +704,7 @@ fn build_level(
     closed: &[(PrototypeId, Transform, u64, u32)],
     proxies: &HashMap<PrototypeId, Proxy>,
     light: Option<OutsideLight<'_>>,
-    b_ref_scene: f64,
+    (b_ref_scene, min_area): (f64, f64),
     config: &InstancedConfig,
 ) -> Result<Option<Level>, InstancingError> {
     let mut b = SceneBuilder::new(&scene.path, &scene.prototype(task.prototype).name);
@@ -774,7 +778,9 @@ fn build_level(
     if b_ref_local > 0.0 && b_ref_scene > 0.0 {
         bf.eps *= b_ref_scene / b_ref_local;
     }
-    let solved = pipeline::run(&local, &BfHand { params: bf }, &local_pipeline(config), &|_| {});
+    let mut pipeline_config = local_pipeline(config);
+    pipeline_config.build.min_area_rel = min_area / local.total_area();
+    let solved = pipeline::run(&local, &BfHand { params: bf }, &pipeline_config, &|_| {});
     Ok(Some(Level {
         polys,
         roles,
