@@ -4,12 +4,14 @@
 //! matrix-free by restarted GMRES, which handles stiff scenes (ρ near 1) in a few dozen products
 //! instead of the O(1/(1−ρ)) sweeps of Jacobi iteration.
 
+mod direct;
 mod estimate;
 mod final_gather;
 mod gmres;
 mod leaf;
 mod operator;
 
+pub use direct::{direct_irradiance, direct_lower_bound};
 pub use estimate::{ESTIMATE_BUDGET, ESTIMATE_MAX_SAMPLES, error_estimate};
 pub use final_gather::final_gather;
 pub use gmres::{GmresResult, gmres};
