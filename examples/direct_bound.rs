@@ -44,6 +44,27 @@ fn main() -> anyhow::Result<()> {
             let (worst, mean) = solver::relative_error(reference, &means);
             let above = solver::polygons_above(reference, &means, 0.03);
             println!("  against REF: error max {:.2}%, mean {:.3}%, {above} polygons above 3%", 100.0 * worst, 100.0 * mean);
+            if std::env::var_os("SHOW").is_some() {
+                // The largest differences (green channel), with the bound where it was estimated.
+                let rmax = reference.radiosity.iter().flat_map(|b| b.iter().copied()).fold(0.0, f64::max);
+                let mut order: Vec<usize> = (0..means.radiosity.len()).collect();
+                order.sort_by(|&a, &b| {
+                    let d = |i: usize| (means.radiosity[i][1] - reference.radiosity[i][1]).abs();
+                    d(b).total_cmp(&d(a))
+                });
+                for &i in &order[..10] {
+                    let g = checked.binary_search(&(i as u32)).map_or(f64::NAN, |k| bound[k][1] / rmax);
+                    let p = &flat.polygons[i].poly;
+                    println!(
+                        "    polygon {i} ({}): {:.3} vs {:.3} of max, bound {g:.3}, centre {:.2}, normal {:.2}",
+                        flat.material_of(i).name,
+                        means.radiosity[i][1] / rmax,
+                        reference.radiosity[i][1] / rmax,
+                        p.centroid(),
+                        p.normal()
+                    );
+                }
+            }
         }
     }
     Ok(())
