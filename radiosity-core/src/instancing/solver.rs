@@ -12,7 +12,9 @@
 //!   proxy's projected area in that direction is a field of parallel beams (a distant-light
 //!   model). Every polygon of the opened level gathers the beams where its level's visibility
 //!   table ([`TABLE_DIRECTIONS`] directions × [`TABLE_RAYS`] rays per polygon, cast once per level)
-//!   says the beam's direction leaves the level unblocked, and reflects the result once as its
+//!   says the beam's direction leaves the level unblocked (and, per instance, where it misses the
+//!   polygons of the levels above that cross the instance's box, [`MAX_INHERITED_OCCLUDERS`] at
+//!   most: a trunk through a branch's box), and reflects the result once as its
 //!   emission. The local problem is then refined and solved with that outside held fixed (its root
 //!   self-link is the local interreflection), its own polygons are streamed to the sink, and its
 //!   hierarchy is dropped (or cached, below) before its sub-instances are opened in turn; the beams
@@ -51,6 +53,7 @@ use std::path::PathBuf;
 
 /// Largest reflectance given to a proxy (the builder requires ρ < 1).
 pub const MAX_PROXY_REFLECTANCE: f64 = 0.99;
+
 /// Smallest extent of a proxy box on any axis, relative to its diagonal (flat prototypes such as a
 /// single leaf still get a box with six faces of positive area).
 pub const MIN_PROXY_EXTENT_REL: f64 = 1e-3;
@@ -273,6 +276,64 @@ struct Task {
     /// The light that arrived at the instance: irradiance perpendicular to each direction of
     /// [`light_directions`] (a distant-light field); `None` at the top.
     incoming: Option<Vec<[f64; 3]>>,
+    /// Polygons of the levels above (scene frame) that cross the instance's box (a trunk through
+    /// a branch's box): the beams from outside are tested against them too (see
+    /// [`inherited_occluders`]).
+    occluders: Occluders,
+}
+
+/// Polygons of the levels above that an instance's beams are tested against: indices into a pool
+/// shared by the instance's siblings (their level's own polygons and its inherited occluders),
+/// so that a level with a thousand closed instances around a trunk holds its polygons once.
+#[derive(Clone, Default)]
+struct Occluders {
+    pool: Option<std::sync::Arc<[Poly]>>,
+    index: Vec<u32>,
+}
+
+impl Occluders {
+    fn iter(&self) -> impl Iterator<Item = &Poly> {
+        self.index.iter().filter_map(|&i| self.pool.as_ref().map(|p| &p[i as usize]))
+    }
+}
+
+/// Most polygons of the levels above handed to an instance as occluders (the largest kept).
+pub const MAX_INHERITED_OCCLUDERS: usize = 64;
+
+/// The polygons of `pool` (scene frame) whose box meets `bx`, largest first, at most
+/// [`MAX_INHERITED_OCCLUDERS`]. The polygons of a closed instance see only their own level's
+/// geometry in its visibility table; a trunk passing through a branch's box, or leaves hugging it,
+/// are otherwise lit as if it were not there (on the age-30 tree, crown-centre leaves next to the
+/// trunk got ten times the light the full solve gives them).
+fn inherited_occluders(pool: &std::sync::Arc<[Poly]>, bx: &Aabb) -> Occluders {
+    let meets = |p: &Poly| {
+        let b = Aabb::from_points(p.vertices());
+        (0..3).all(|k| b.min[k] <= bx.max[k] && b.max[k] >= bx.min[k])
+    };
+    let mut index: Vec<u32> = (0..pool.len() as u32).filter(|&i| meets(&pool[i as usize])).collect();
+    if index.len() > MAX_INHERITED_OCCLUDERS {
+        index.sort_by(|&a, &b| pool[b as usize].area().total_cmp(&pool[a as usize].area()));
+        index.truncate(MAX_INHERITED_OCCLUDERS);
+    }
+    // One list per pending instance: hold no spare capacity.
+    index.shrink_to_fit();
+    Occluders { pool: (!index.is_empty()).then(|| pool.clone()), index }
+}
+
+/// Whether the ray from `x` along `d` (t > 0) crosses the convex polygon `p`.
+fn ray_hits(x: DVec3, d: DVec3, p: &Poly) -> bool {
+    let n = p.area_vector();
+    let denom = n.dot(d);
+    if denom == 0.0 {
+        return false;
+    }
+    let t = n.dot(p.v[0] - x) / denom;
+    if t <= 0.0 {
+        return false;
+    }
+    let y = x + d * t;
+    let vs = p.vertices();
+    (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(y - vs[k]).dot(n) >= 0.0)
 }
 
 /// What a polygon of a local problem stands for.
@@ -313,7 +374,14 @@ fn solve_depth_first(
     let cache = config.cache_dir.as_deref().map(PropertyCache::new);
     let mut proxies: HashMap<PrototypeId, Proxy> = HashMap::new();
     let mut stats = InstancedStats::default();
-    let mut stack = vec![Task { prototype: scene.root, transform: Transform::IDENTITY, flat_base: 0, depth: 0, incoming: None }];
+    let mut stack = vec![Task {
+        prototype: scene.root,
+        transform: Transform::IDENTITY,
+        flat_base: 0,
+        depth: 0,
+        incoming: None,
+        occluders: Occluders::default(),
+    }];
     // Every local BF threshold stays relative to the scene's largest emission (see `build_level`).
     let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
     // The smallest element is as large in every local problem as in the flattened solve (its
@@ -373,6 +441,14 @@ fn solve_depth_first(
             }
         }
         own.sort_by_key(|o| o.2);
+        let pool: std::sync::Arc<[Poly]> = if closed.is_empty() {
+            std::sync::Arc::from([])
+        } else {
+            own.iter().map(|o| o.0).chain(task.occluders.iter().copied()).collect()
+        };
+        let mut child_occluders: Vec<Occluders> =
+            closed.iter().map(|&(c, t, _, _)| inherited_occluders(&pool, &t.aabb(&padded(&bounds[c as usize])))).collect();
+        drop(pool);
 
         // Properties of the closed prototypes.
         for &(c, _, _, _) in &closed {
@@ -424,8 +500,10 @@ fn solve_depth_first(
         // opening. Directions are taken into the level's own frame.
         let rotation = similarity.as_ref().map_or(DMat3::IDENTITY, |s: &Similarity| s.rotation);
         let dirs_level: Vec<DVec3> = dirs.iter().map(|d| rotation.transpose() * *d).collect();
+        let world_to_level = similarity.as_ref().map_or(DMat4::IDENTITY, |s| s.matrix.inverse());
+        let occluders: Vec<Poly> = task.occluders.iter().map(|p| Transform { matrix: world_to_level }.poly(p)).collect();
         let (external, external_bins) = match (&task.incoming, &level.table) {
-            (Some(field), Some(table)) => table_irradiance(&level.polys, table, &dirs_level, field, &level.roles),
+            (Some(field), Some(table)) => table_irradiance(&level.polys, table, &dirs_level, field, &level.roles, &occluders),
             _ => (Vec::new(), Vec::new()),
         };
         let solution = match level.solution.take() {
@@ -550,7 +628,8 @@ fn solve_depth_first(
             for (flux, p) in field.iter_mut().zip(&projected[slot]) {
                 *flux = flux.map(|f| if *p > 0.0 { f / p } else { 0.0 });
             }
-            stack.push(Task { prototype: c, transform: t, flat_base: base, depth, incoming: Some(field) });
+            let occluders = std::mem::take(&mut child_occluders[slot]);
+            stack.push(Task { prototype: c, transform: t, flat_base: base, depth, incoming: Some(field), occluders });
         }
     }
     stats.levels_cached_peak_bytes = levels.peak_bytes as u64;
@@ -755,7 +834,7 @@ fn build_level(
     if let Some(OutsideLight { dirs, field, raise }) = light {
         let caster = crate::visibility::RayCaster::new(&local);
         let t = VisibilityTable::build(&polys, &caster, local.bounds().diagonal(), config.properties.seed);
-        let (external, _) = table_irradiance(&polys, &t, dirs, field, &[]);
+        let (external, _) = table_irradiance(&polys, &t, dirs, field, &[], &[]);
         table = Some(t);
         let twin = crate::hierarchy::twins(&local);
         let mut materials = Vec::with_capacity(local.polygons.len());
@@ -942,6 +1021,9 @@ impl LevelCache {
 
 /// Directions of a level's visibility table (a Fibonacci sphere in the level's frame).
 pub const TABLE_DIRECTIONS: u32 = 128;
+/// Seed of the points from which beams are tested against inherited occluders.
+const OCCLUDER_SEED: u64 = 0x0CC1;
+
 /// Rays per polygon and table direction, stratified over the polygon.
 pub const TABLE_RAYS: u32 = 4;
 
@@ -995,18 +1077,35 @@ fn table_irradiance(
     dirs: &[DVec3],
     field: &[[f64; 3]],
     roles: &[Role],
+    occluders: &[Poly],
 ) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>) {
     let strongest = field.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max);
     let active: Vec<usize> =
         (0..dirs.len()).filter(|&b| field[b].iter().copied().fold(0.0, f64::max) > FIELD_REL_MIN * strongest).collect();
     let nearest: Vec<usize> = dirs.iter().map(|d| nearest_direction(&table.dirs, *d)).collect();
     let k = table.dirs.len();
+    use rayon::prelude::*;
     polys
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(i, p)| {
             let n = p.normal();
             let keep = is_proxy(roles, i);
+            // Points of the polygon from which the beams are tested against the occluders handed
+            // down from the levels above (none for most instances).
+            // Only occluders with a vertex in front of the polygon's plane can stop a beam it takes.
+            let x0 = p.v[0];
+            let ahead: Vec<&Poly> = occluders.iter().filter(|o| o.vertices().iter().any(|v| n.dot(*v - x0) > 0.0)).collect();
+            let points: Vec<DVec3> = if ahead.is_empty() {
+                Vec::new()
+            } else {
+                let mut rng = crate::visibility::Rng::for_link(OCCLUDER_SEED, i as u32, 0);
+                (0..TABLE_RAYS)
+                    .map(|s| {
+                        p.sample((f64::from(s) + rng.next_f64()) / f64::from(TABLE_RAYS), rng.next_f64()) + n * (1e-9 * p.area().sqrt())
+                    })
+                    .collect()
+            };
             let mut bins = if keep { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
             let mut acc = [0.0; 3];
             for &b in &active {
@@ -1015,7 +1114,11 @@ fn table_irradiance(
                 if cos <= 0.0 || clear == 0 {
                     continue;
                 }
-                let v = f64::from(clear) / f64::from(TABLE_RAYS);
+                let mut v = f64::from(clear) / f64::from(TABLE_RAYS);
+                if !points.is_empty() {
+                    let open = points.iter().filter(|&&x| !ahead.iter().any(|o| ray_hits(x, dirs[b], o))).count();
+                    v *= open as f64 / points.len() as f64;
+                }
                 for c in 0..3 {
                     let e = field[b][c] * cos * v;
                     acc[c] += e;
