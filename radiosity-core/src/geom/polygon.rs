@@ -63,6 +63,21 @@ impl Poly {
         0.5 * n
     }
 
+    /// Where the line `a + t·d` crosses the polygon (convex, edges included): its parameter `t`,
+    /// or `None` when it misses the polygon or runs parallel to its plane.
+    #[must_use]
+    pub fn crossing(&self, a: DVec3, d: DVec3) -> Option<f64> {
+        let n = self.area_vector();
+        let denom = n.dot(d);
+        if denom == 0.0 {
+            return None;
+        }
+        let t = n.dot(self.v[0] - a) / denom;
+        let x = a + d * t;
+        let vs = self.vertices();
+        (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(x - vs[k]).dot(n) >= 0.0).then_some(t)
+    }
+
     /// Area in square scene units.
     #[must_use]
     pub fn area(&self) -> f64 {

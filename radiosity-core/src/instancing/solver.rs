@@ -293,7 +293,7 @@ struct Occluders {
 
 impl Occluders {
     fn iter(&self) -> impl Iterator<Item = &Poly> {
-        self.index.iter().filter_map(|&i| self.pool.as_ref().map(|p| &p[i as usize]))
+        self.pool.iter().flat_map(|pool| self.index.iter().map(move |&i| &pool[i as usize]))
     }
 }
 
@@ -417,22 +417,6 @@ impl PoolGrid {
         found.dedup();
         found
     }
-}
-
-/// Whether the ray from `x` along `d` (t > 0) crosses the convex polygon `p`.
-fn ray_hits(x: DVec3, d: DVec3, p: &Poly) -> bool {
-    let n = p.area_vector();
-    let denom = n.dot(d);
-    if denom == 0.0 {
-        return false;
-    }
-    let t = n.dot(p.v[0] - x) / denom;
-    if t <= 0.0 {
-        return false;
-    }
-    let y = x + d * t;
-    let vs = p.vertices();
-    (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(y - vs[k]).dot(n) >= 0.0)
 }
 
 /// What a polygon of a local problem stands for.
@@ -1218,7 +1202,7 @@ fn table_irradiance(
                 }
                 let mut v = f64::from(clear) / f64::from(TABLE_RAYS);
                 if !points.is_empty() {
-                    let open = points.iter().filter(|&&x| !ahead.iter().any(|o| ray_hits(x, dirs[b], o))).count();
+                    let open = points.iter().filter(|&&x| !ahead.iter().any(|o| o.crossing(x, dirs[b]).is_some_and(|t| t > 0.0))).count();
                     v *= open as f64 / points.len() as f64;
                 }
                 for c in 0..3 {

@@ -85,18 +85,7 @@ pub(super) fn segment_meets_inv(a: DVec3, inv: DVec3, b: &Aabb) -> bool {
 /// Whether the segment `a + t d`, `t` in `[SEGMENT_END_EPS, 1 − SEGMENT_END_EPS]`, crosses the
 /// convex polygon (edges included).
 fn segment_hits_polygon(a: DVec3, d: DVec3, poly: &Poly) -> bool {
-    let n = poly.area_vector();
-    let denom = n.dot(d);
-    if denom == 0.0 {
-        return false;
-    }
-    let t = n.dot(poly.v[0] - a) / denom;
-    if !(SEGMENT_END_EPS..=1.0 - SEGMENT_END_EPS).contains(&t) {
-        return false;
-    }
-    let x = a + d * t;
-    let vs = poly.vertices();
-    (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(x - vs[k]).dot(n) >= 0.0)
+    poly.crossing(a, d).is_some_and(|t| (SEGMENT_END_EPS..=1.0 - SEGMENT_END_EPS).contains(&t))
 }
 
 /// A polygon ready for many segment tests: its plane and in-plane outward edge planes.
