@@ -75,7 +75,7 @@ pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: Form
     // contour integral with every receiver point in the source's plane, where it is undefined
     // (it returned the clamp, 1): the leaf-resolution gather evaluates such pairs when a link to a
     // cluster holding the face was accepted for the cluster's other members.
-    if behind_plane(sp, s.normal, s.radius, rp) || behind_plane(rp, r.normal, r.radius, sp) {
+    if behind_surface(s, rp.vertices().iter().copied()) || behind_surface(r, sv.iter().copied()) {
         return 0.0;
     }
     if quality == FormFactorQuality::Estimate {
@@ -174,15 +174,18 @@ fn rule_average(rp: &Poly, rn: DVec3, sv: &[DVec3], sn: DVec3, rule: &quadrature
     f
 }
 
-/// Relative tolerance (times the plane polygon's radius) within which a vertex counts as on a
-/// plane in [`link_form_factor`]'s facing test.
+/// Relative tolerance (times the plane element's radius) within which a point counts as on a
+/// surface's plane in [`behind_surface`].
 pub const ON_PLANE_REL_TOL: f64 = 1e-9;
 
-/// Whether every vertex of `other` lies on or behind the plane of `plane` (normal `normal`).
-fn behind_plane(plane: &Poly, normal: DVec3, radius: f64, other: &Poly) -> bool {
-    let origin = plane.v[0];
-    let tol = ON_PLANE_REL_TOL * radius;
-    other.vertices().iter().all(|v| normal.dot(*v - origin) <= tol)
+/// Whether every one of `points` lies on or behind the plane of the surface element `plane`
+/// (false for a cluster, which has no plane): the facing test of refinement
+/// ([`crate::refine::LinkCtx::facing`]) and of [`link_form_factor`].
+#[must_use]
+pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) -> bool {
+    let Some(p) = plane.poly() else { return false };
+    let (origin, tol) = (p.v[0], ON_PLANE_REL_TOL * plane.radius);
+    points.into_iter().all(|v| plane.normal.dot(v - origin) <= tol)
 }
 
 /// Clusters with at most this many polygons use their members' exact projected area in the link

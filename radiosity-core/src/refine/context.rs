@@ -297,21 +297,20 @@ impl<'a> LinkCtx<'a> {
     pub fn facing(&self) -> bool {
         let (s, r) = (self.emitter_element(), self.receiver_element());
         let behind = |plane_el: &Element, other: &Element| -> bool {
-            let Some(p) = plane_el.poly() else { return false };
-            let origin = p.v[0];
-            let tol = 1e-9 * plane_el.radius;
             match other.poly() {
-                Some(q) => q.vertices().iter().all(|v| plane_el.normal.dot(*v - origin) <= tol),
+                Some(q) => formfactor::behind_surface(plane_el, q.vertices().iter().copied()),
                 None => {
                     let b = &other.bounds;
-                    (0..8).all(|c| {
-                        let corner = crate::geom::DVec3::new(
-                            if c & 1 == 0 { b.min.x } else { b.max.x },
-                            if c & 2 == 0 { b.min.y } else { b.max.y },
-                            if c & 4 == 0 { b.min.z } else { b.max.z },
-                        );
-                        plane_el.normal.dot(corner - origin) <= tol
-                    })
+                    formfactor::behind_surface(
+                        plane_el,
+                        (0..8).map(|c| {
+                            crate::geom::DVec3::new(
+                                if c & 1 == 0 { b.min.x } else { b.max.x },
+                                if c & 2 == 0 { b.min.y } else { b.max.y },
+                                if c & 4 == 0 { b.min.z } else { b.max.z },
+                            )
+                        }),
+                    )
                 }
             }
         };
