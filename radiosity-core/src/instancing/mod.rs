@@ -44,6 +44,7 @@
 
 pub mod auto;
 pub mod bench;
+pub mod caster;
 mod error;
 pub mod flatten;
 pub mod format;
@@ -57,6 +58,7 @@ pub mod solver;
 pub mod write;
 
 pub use auto::{AutoOptions, AutoReport, AutoResult, auto_instance};
+pub use caster::InstanceCaster;
 pub use error::InstancingError;
 pub use flatten::{FlattenOptions, flatten, flatten_prototype};
 pub use format::{load, parse};
