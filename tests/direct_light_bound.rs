@@ -5,7 +5,7 @@
 //! whole crown, and the flattened solve (the reference of `radiosity bench instancing`) is
 //! checked against it.
 
-use radiosity::instancing::{self, FlattenOptions, InstancedConfig, solve_full};
+use radiosity::instancing::{self, FlattenOptions, InstancedConfig, PolygonMeans, solve_full, solve_instanced};
 use radiosity::refine::BfParams;
 use radiosity::solve::direct_lower_bound;
 use radiosity::visibility::RayCaster;
@@ -23,12 +23,10 @@ const SAMPLES: u32 = 400;
 /// cluster-first splitting and back-to-back form factor fixes (the same test, same seeds).
 const SHORTFALL_TOL: f64 = 0.02;
 
-#[test]
-fn flattened_tree_solve_stays_above_direct_light() {
-    let scene = instancing::generate_tree(AGE, 1);
-    let flat = instancing::flatten(&scene, &FlattenOptions { two_sided_pairs: true }).unwrap();
-    let config = InstancedConfig { bf: BfParams { eps: EPS }, ..InstancedConfig::default() };
-    let (means, _) = solve_full(&scene, &config).unwrap();
+/// The worst shortfall of `means` below the direct-light bound (fraction of the largest
+/// radiosity), at which polygon, and how many checked polygons are lit above 1% of the maximum.
+fn worst_shortfall(scene: &instancing::InstancedScene, means: &PolygonMeans) -> (f64, u32, usize) {
+    let flat = instancing::flatten(scene, &FlattenOptions { two_sided_pairs: true }).unwrap();
     let caster = RayCaster::new(&flat);
     let twin = radiosity::hierarchy::twins(&flat);
     let checked: Vec<u32> = (0..flat.polygons.len() as u32).step_by(STRIDE).collect();
@@ -50,5 +48,28 @@ fn flattened_tree_solve_stays_above_direct_light() {
         100.0 * worst
     );
     assert!(lit > checked.len() / 10, "the check needs directly lit polygons: {lit}");
+    (worst, at, lit)
+}
+
+#[test]
+fn flattened_tree_solve_stays_above_direct_light() {
+    let scene = instancing::generate_tree(AGE, 1);
+    let config = InstancedConfig { bf: BfParams { eps: EPS }, ..InstancedConfig::default() };
+    let (means, _) = solve_full(&scene, &config).unwrap();
+    let (worst, at, _) = worst_shortfall(&scene, &means);
+    assert!(worst <= SHORTFALL_TOL, "polygon {at} falls {:.2}% of max below the direct light it receives", 100.0 * worst);
+}
+
+/// The instanced solve traces the lamps' direct light through every instance's own geometry
+/// (nested per-prototype BVHs), so it too stays above the bound. Measured: worst shortfall 0.43% of max;
+/// with the direct light carried by the parallel beams instead (`direct_samples: 0`, each instance
+/// lit with its average visibility) 2.49%, above the tolerance.
+#[test]
+fn instanced_tree_solve_stays_above_direct_light() {
+    let scene = instancing::generate_tree(AGE, 1);
+    let config = InstancedConfig { bf: BfParams { eps: EPS }, ..InstancedConfig::default() };
+    let mut means = PolygonMeans::default();
+    let _ = solve_instanced(&scene, &config, &mut means).unwrap();
+    let (worst, at, _) = worst_shortfall(&scene, &means);
     assert!(worst <= SHORTFALL_TOL, "polygon {at} falls {:.2}% of max below the direct light it receives", 100.0 * worst);
 }

@@ -72,6 +72,10 @@ pub struct InstancingBenchArgs {
     /// Which nesting depths the instanced solves keep closed: `all`, `every-N` or `none`.
     #[arg(long, default_value = "all", value_name = "POLICY")]
     pub instance_levels: String,
+    /// Point pairs per (polygon, light) from which the instanced solves ray trace the lights'
+    /// direct light below the top level (0: the parallel beams carry it).
+    #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().direct_samples, value_name = "N")]
+    pub direct_samples: u32,
     /// Internal: run one method (`full` or `instanced`) and write its per-polygon means here.
     #[arg(long, hide = true, num_args = 2, value_names = ["METHOD", "FILE"])]
     pub child: Vec<String>,
@@ -416,7 +420,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     let instance_levels: radiosity::instancing::InstanceLevels =
         args.instance_levels.parse().map_err(|e: String| anyhow::anyhow!("--instance-levels: {e}"))?;
     let config = |eps: f64| {
-        let mut config = InstancedConfig { instance_levels, ..InstancedConfig::default() };
+        let mut config = InstancedConfig { instance_levels, direct_samples: args.direct_samples, ..InstancedConfig::default() };
         config.bf.eps = eps;
         config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
         config
@@ -453,6 +457,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
         let o = Command::new(&exe)
             .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string()])
             .args(["--instance-levels", &args.instance_levels])
+            .args(["--direct-samples", &args.direct_samples.to_string()])
             .args(extra)
             .output()
             .with_context(|| format!("running {}", exe.display()))?;

@@ -47,6 +47,11 @@ pub struct SolveArgs {
     /// (depths N, 2N, ...; the others are opened in place), or `none` (one flattened problem).
     #[arg(long, default_value = "all", value_name = "POLICY")]
     pub instance_levels: radiosity::instancing::InstanceLevels,
+    /// Instanced scenes: point pairs per (polygon, light) from which the direct light of the top
+    /// level's lights is ray traced below it, through every instance's own geometry (0: carried by
+    /// the parallel beams into each instance, with the instance's average visibility).
+    #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().direct_samples, value_name = "N")]
+    pub direct_samples: u32,
 }
 
 /// Values of `--instances`.
@@ -178,6 +183,7 @@ fn solve_instanced(
     config.pipeline = args.options.config();
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     config.instance_levels = args.instance_levels;
+    config.direct_samples = args.direct_samples;
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
     let stats = instancing::solve_instanced(scene, &config, &mut sink)?;

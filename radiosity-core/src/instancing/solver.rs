@@ -19,6 +19,15 @@
 //!   self-link is the local interreflection), its own polygons are streamed to the sink, and its
 //!   hierarchy is dropped (or cached, below) before its sub-instances are opened in turn; the beams
 //!   that reach a sub-instance's proxy are passed on to it bin by bin.
+//! - direct light (visibility through instances): the part of each field that came straight from
+//!   the top level's emitters is tracked apart (at the top, a link's share `E_source / B_source`;
+//!   below, the direct beams that reach a proxy). Proxy faces still receive it as beams, but every
+//!   own polygon below the top gets it ray traced instead, from
+//!   [`InstancedConfig::direct_samples`] point pairs per emitter, through
+//!   [`super::InstanceCaster`]: one BVH per prototype over its triangles and its instances' boxes,
+//!   shared by all its instances, so each ray is blocked by every instance's own geometry (the
+//!   other branches of a crown), not by the instance's average visibility. The brightness class
+//!   (below) bounds the traced light too.
 //!
 //! Reuse: the refinement of a level (hierarchy, links, leaf-resolution coefficients, visibility
 //! table) depends on its geometry and, through the BF criterion, on how bright its light is; it is
@@ -34,8 +43,9 @@
 //! computation and every local problem bounded. So are instances nearer to an emitter of their level
 //! than [`InstancedConfig::open_near_emitter`] times their size, where parallel beams would miss
 //! how much brighter their near side is. Memory is bounded by the largest local problem, plus the
-//! level cache's budget, plus one field ([`LIGHT_DIRECTIONS`] RGB values) per pending instance; the
-//! flattened scene is never built.
+//! level cache's budget, plus one field ([`LIGHT_DIRECTIONS`] RGB values, and the few bins of its
+//! direct part) per pending instance, plus one BVH per prototype (built once the top level is
+//! freed); the flattened scene is never built.
 
 use super::InstancingError;
 use super::flatten::{FlattenOptions, reversed};
@@ -94,6 +104,12 @@ pub struct InstancedConfig {
     /// tree at eps 0.05 it made the answer no closer to the full solve (0.9: max error 5.62%
     /// against 5.54%, mean 0.169% against 0.150%; 0.5: 5.89%, and 58 MB instead of 20 MB).
     pub open_overlap: f64,
+    /// Point pairs per (polygon, emitter) from which the light that every polygon below the top
+    /// level receives straight from the top level's emitters is ray traced through the nested
+    /// per-prototype BVHs ([`super::InstanceCaster`]: every instance blocks with its own geometry),
+    /// instead of arriving with the parallel beams, whose visibility is the instance's average.
+    /// 0 leaves all light to the beams.
+    pub direct_samples: u32,
     /// Budget (approximate bytes) of the levels kept for reuse: a level lit from outside is
     /// refined once and reused, solve only, for every later instance of its prototype that lies a
     /// similarity away and whose light is no brighter (see [`solve_instanced`]). 0 disables reuse.
@@ -115,6 +131,7 @@ impl Default for InstancedConfig {
             level_cache_bytes: 16_000_000,
             instance_levels: InstanceLevels::All,
             open_overlap: 1.0,
+            direct_samples: 16,
         }
     }
 }
@@ -276,6 +293,10 @@ struct Task {
     /// The light that arrived at the instance: irradiance perpendicular to each direction of
     /// [`light_directions`] (a distant-light field); `None` at the top.
     incoming: Option<Vec<[f64; 3]>>,
+    /// The part of `incoming` that came straight from the top level's emitters, per direction
+    /// bin (the few bins that hold any): below the top, each polygon's own share of it is ray
+    /// traced instead (see [`InstancedConfig::direct_samples`]); proxy faces keep the beams.
+    direct: Vec<(u32, [f64; 3])>,
     /// Polygons of the levels above (scene frame) that cross the instance's box (a trunk through
     /// a branch's box): the beams from outside are tested against them too (see
     /// [`inherited_occluders`]).
@@ -463,8 +484,14 @@ fn solve_depth_first(
         flat_base: 0,
         depth: 0,
         incoming: None,
+        direct: Vec::new(),
         occluders: Occluders::default(),
     }];
+    // Direct light: the top level's emitters (scene frame) and the caster that sees every
+    // instance's own geometry, built after the top level (the largest local problem) is freed.
+    let tracing = config.direct_samples > 0;
+    let mut caster: Option<super::InstanceCaster> = None;
+    let mut direct_emitters: Vec<(Poly, [f64; 3])> = Vec::new();
     // Every local BF threshold stays relative to the scene's largest emission (see `build_level`).
     let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
     // The smallest element is as large in every local problem as in the flattened solve (its
@@ -524,6 +551,13 @@ fn solve_depth_first(
             }
         }
         own.sort_by_key(|o| o.2);
+        if task.incoming.is_none() && tracing {
+            direct_emitters = own
+                .iter()
+                .filter(|o| scene.materials[o.1 as usize].is_emitter())
+                .map(|o| (o.0, scene.materials[o.1 as usize].emission))
+                .collect();
+        }
         let pool: std::sync::Arc<[Poly]> = if closed.is_empty() {
             std::sync::Arc::from([])
         } else {
@@ -562,12 +596,51 @@ fn solve_depth_first(
         // same brightness class and which lies a similarity (rigid motion and uniform scale)
         // away, else built, refined and (below the top) cached.
         let t_local = std::time::Instant::now();
-        let class = task.incoming.as_ref().map(|field| brightness_class(irradiance_bound(&dirs, field)));
+        // Below the top, the light straight from the top level's emitters is split off the field
+        // and ray traced to every own polygon (see `InstancedConfig::direct_samples`).
+        if tracing && task.incoming.is_some() && caster.is_none() {
+            let c = super::InstanceCaster::new(scene);
+            if config.trace {
+                eprintln!("direct light: nested BVHs of {} prototypes, {:.1} MB", scene.prototypes.len(), c.bytes() as f64 / 1e6);
+            }
+            caster = Some(c);
+        }
+        let split = match (&task.incoming, &caster) {
+            (Some(field), Some(caster)) => {
+                let mut direct = vec![[0.0; 3]; field.len()];
+                for &(b, e) in &task.direct {
+                    direct[b as usize] = e;
+                }
+                let rest = field.iter().zip(&direct).map(|(f, d)| std::array::from_fn(|c| (f[c] - d[c]).max(0.0))).collect();
+                let traced = traced_direct(scene, &own, task.flat_base, &direct_emitters, caster, config.direct_samples);
+                Some(DirectSplit { rest, direct, traced })
+            }
+            _ => None,
+        };
+        // The brightness class bounds every polygon's light from outside: the beams', and the
+        // traced direct light (which a polygon may get unattenuated where the beams are the
+        // instance's average).
+        let class = task.incoming.as_ref().map(|field| {
+            let mut bound = irradiance_bound(&dirs, field);
+            if let Some(split) = &split {
+                let rest = irradiance_bound(&dirs, &split.rest);
+                for c in 0..3 {
+                    let traced = split.traced.iter().map(|t| t[c]).fold(0.0, f64::max);
+                    bound[c] = bound[c].max(rest[c] + traced);
+                }
+            }
+            brightness_class(bound)
+        });
         let key = (task.prototype, inlined, class.map_or(i32::MIN, |c| c.0));
         let reused = if class.is_some() { levels.find(&key, &task.transform.matrix) } else { None };
         let mut fresh = None;
         if reused.is_none() {
-            let light = task.incoming.as_deref().zip(class).map(|(field, (_, raise))| OutsideLight { dirs: &dirs, field, raise });
+            let light = task.incoming.as_deref().zip(class).map(|(field, (_, raise))| OutsideLight {
+                dirs: &dirs,
+                field,
+                split: split.as_ref(),
+                raise,
+            });
             let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, (b_ref_scene, min_area), config)? else { continue };
             fresh = Some(level);
         }
@@ -588,9 +661,11 @@ fn solve_depth_first(
         let dirs_level: Vec<DVec3> = dirs.iter().map(|d| rotation.transpose() * *d).collect();
         let world_to_level = similarity.as_ref().map_or(DMat4::IDENTITY, |s| s.matrix.inverse());
         let occluders: Vec<Poly> = task.occluders.iter().map(|p| Transform { matrix: world_to_level }.poly(p)).collect();
-        let (external, external_bins) = match (&task.incoming, &level.table) {
-            (Some(field), Some(table)) => table_irradiance(&level.polys, table, &dirs_level, field, &level.roles, &occluders),
-            _ => (Vec::new(), Vec::new()),
+        let (external, external_bins, direct_bins) = match (&task.incoming, &level.table) {
+            (Some(field), Some(table)) => {
+                outside_irradiance(&level.polys, table, &dirs_level, field, split.as_ref(), &level.roles, &occluders)
+            }
+            _ => (Vec::new(), Vec::new(), Vec::new()),
         };
         let solution = match level.solution.take() {
             Some(solution) => solution,
@@ -672,12 +747,15 @@ fn solve_depth_first(
         // its share of the beams from outside, as a field per closed instance. Two passes over the
         // links (per-face totals, then shares), so that no per-face field is ever held.
         let mut face_total = vec![[0.0; 3]; level.polys.len()];
-        for_each_link_direction(h, &level.links, &solution.radiosity, &level.roles, &dirs_level, |face, _, w| {
+        for_each_link_direction(h, &level.links, &solution.radiosity, &level.roles, &dirs_level, |face, _, w, _| {
             for c in 0..3 {
                 face_total[face][c] += w[c];
             }
         });
         let mut fields = vec![vec![[0.0; 3]; dirs.len()]; closed.len()];
+        // The part from the top level's emitters, sparse (a few bins per instance).
+        let mut direct_fields: Vec<Vec<(u32, [f64; 3])>> = vec![Vec::new(); closed.len()];
+        let emitted = if tracing && task.incoming.is_none() { Some(EmittedShare::new(h, &level.base_emission)) } else { None };
         let mut projected = vec![vec![0.0; dirs.len()]; closed.len()];
         for (i, role) in level.roles.iter().enumerate() {
             let Role::ProxyFace { slot, .. } = *role else { continue };
@@ -692,15 +770,27 @@ fn solve_depth_first(
                     let unattributed = if face_total[i][c] <= 0.0 && b == along_normal { h_local[c] } else { 0.0 };
                     fields[slot][b][c] += area * (ext + unattributed);
                 }
+                if let Some(d) = direct_bins.get(i).and_then(|v| v.get(b)) {
+                    add_to_bin(&mut direct_fields[slot], b, d.map(|x| area * x));
+                }
             }
         }
-        for_each_link_direction(h, &level.links, &solution.radiosity, &level.roles, &dirs_level, |face, b, w| {
+        for_each_link_direction(h, &level.links, &solution.radiosity, &level.roles, &dirs_level, |face, b, w, source| {
             let Role::ProxyFace { slot } = level.roles[face] else { return };
             let area = level.polys[face].area();
+            let share: [f64; 3] = std::array::from_fn(|c| {
+                if face_total[face][c] > 0.0 { area * face_irradiance[face][c] * w[c] / face_total[face][c] } else { 0.0 }
+            });
             for c in 0..3 {
-                if face_total[face][c] > 0.0 {
-                    fields[slot][b][c] += area * face_irradiance[face][c] * w[c] / face_total[face][c];
-                }
+                fields[slot][b][c] += share[c];
+            }
+            if let Some(emitted) = &emitted {
+                let (e, b_src) = (emitted.of(h, source), solution.radiosity[source as usize]);
+                add_to_bin(
+                    &mut direct_fields[slot],
+                    b,
+                    std::array::from_fn(|c| if b_src[c] > 0.0 { share[c] * (e[c] / b_src[c]).min(1.0) } else { 0.0 }),
+                );
             }
         });
         drop(solution);
@@ -715,7 +805,13 @@ fn solve_depth_first(
                 *flux = flux.map(|f| if *p > 0.0 { f / p } else { 0.0 });
             }
             let occluders = std::mem::take(&mut child_occluders[slot]);
-            stack.push(Task { prototype: c, transform: t, flat_base: base, depth, incoming: Some(field), occluders });
+            let mut direct = std::mem::take(&mut direct_fields[slot]);
+            for (b, flux) in &mut direct {
+                let p = projected[slot][*b as usize];
+                *flux = flux.map(|f| if p > 0.0 { f / p } else { 0.0 });
+            }
+            direct.retain(|(_, e)| e.iter().any(|&x| x > 0.0));
+            stack.push(Task { prototype: c, transform: t, flat_base: base, depth, incoming: Some(field), direct, occluders });
         }
     }
     stats.levels_cached_peak_bytes = levels.peak_bytes as u64;
@@ -778,7 +874,7 @@ fn nearest_direction(dirs: &[DVec3], u: DVec3) -> usize {
     best.0
 }
 
-/// Calls `f(face, bin, F·V·B_source)` (RGB) for every link that arrived at a proxy face (at the
+/// Calls `f(face, bin, F·V·B_source, source)` (RGB) for every link that arrived at a proxy face (at the
 /// face or below, or at a cluster holding it), with the bin of the direction toward its source (for
 /// a cluster receiver, weighted by the face's cosine toward it).
 fn for_each_link_direction(
@@ -787,7 +883,7 @@ fn for_each_link_direction(
     radiosity: &[[f64; 3]],
     roles: &[Role],
     dirs: &[DVec3],
-    mut f: impl FnMut(usize, usize, [f64; 3]),
+    mut f: impl FnMut(usize, usize, [f64; 3], ElementId),
 ) {
     for l in links {
         let (r, src) = (h.get(l.receiver), h.get(l.source));
@@ -802,7 +898,7 @@ fn for_each_link_direction(
                     let u = (src.center - face.center).normalize_or_zero();
                     let cos = face.normal.dot(u);
                     if cos > 0.0 {
-                        f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x * cos));
+                        f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x * cos), l.source);
                     }
                 }
             }
@@ -810,7 +906,7 @@ fn for_each_link_direction(
                 let Some(p) = r.polygon() else { continue };
                 if is_proxy(roles, p as usize) {
                     let u = (src.center - r.center).normalize_or_zero();
-                    f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x));
+                    f(p as usize, nearest_direction(dirs, u), b_src.map(|x| l.ff * l.vis * x), l.source);
                 }
             }
         }
@@ -917,10 +1013,10 @@ fn build_level(
     let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
     let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
     let mut table = None;
-    if let Some(OutsideLight { dirs, field, raise }) = light {
+    if let Some(OutsideLight { dirs, field, split, raise }) = light {
         let caster = crate::visibility::RayCaster::new(&local);
         let t = VisibilityTable::build(&polys, &caster, local.bounds().diagonal(), config.properties.seed);
-        let (external, _) = table_irradiance(&polys, &t, dirs, field, &[], &[]);
+        let (external, _, _) = outside_irradiance(&polys, &t, dirs, field, split, &roles, &[]);
         table = Some(t);
         let twin = crate::hierarchy::twins(&local);
         let mut materials = Vec::with_capacity(local.polygons.len());
@@ -966,6 +1062,7 @@ fn build_level(
 struct OutsideLight<'a> {
     dirs: &'a [DVec3],
     field: &'a [[f64; 3]],
+    split: Option<&'a DirectSplit>,
     raise: f64,
 }
 
@@ -1153,6 +1250,45 @@ impl VisibilityTable {
     }
 }
 
+/// Irradiance from outside of every polygon of a level, per proxy face its share of each beam, and
+/// of that the part straight from the top level's emitters (empty without a `split`): the field's
+/// beams (see [`table_irradiance`]), except that with a `split` the own polygons get the traced
+/// direct light in place of the field's direct part.
+#[allow(clippy::type_complexity)]
+fn outside_irradiance(
+    polys: &[Poly],
+    table: &VisibilityTable,
+    dirs: &[DVec3],
+    field: &[[f64; 3]],
+    split: Option<&DirectSplit>,
+    roles: &[Role],
+    occluders: &[Poly],
+) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, Vec<Vec<[f64; 3]>>) {
+    let Some(split) = split else {
+        let (external, bins) = table_irradiance(polys, table, dirs, field, roles, occluders);
+        return (external, bins, Vec::new());
+    };
+    let (mut external, mut bins) = table_irradiance(polys, table, dirs, &split.rest, roles, occluders);
+    let (beamed, direct_bins) = table_irradiance(polys, table, dirs, &split.direct, roles, occluders);
+    for (i, e) in external.iter_mut().enumerate() {
+        let add = match roles.get(i) {
+            Some(Role::Own(info)) => split.traced.get(info.flat_index as usize).copied().unwrap_or([0.0; 3]),
+            _ => beamed[i],
+        };
+        for c in 0..3 {
+            e[c] += add[c];
+        }
+    }
+    for (total, d) in bins.iter_mut().zip(&direct_bins) {
+        for (t, x) in total.iter_mut().zip(d) {
+            for c in 0..3 {
+                t[c] += x[c];
+            }
+        }
+    }
+    (external, bins, direct_bins)
+}
+
 /// Irradiance from outside of every polygon of a level (see the module docs): `field` is the
 /// irradiance perpendicular to each beam of `dirs` (taken into the level's frame), received where
 /// the table says the beam's direction leaves the level. For the proxy faces among `roles`, the
@@ -1217,6 +1353,115 @@ fn table_irradiance(
         })
         .unzip()
 }
+
+/// Adds `x` to bin `b` of a sparse field.
+fn add_to_bin(field: &mut Vec<(u32, [f64; 3])>, b: usize, x: [f64; 3]) {
+    if x.iter().all(|&v| v == 0.0) {
+        return;
+    }
+    match field.iter_mut().find(|(k, _)| *k as usize == b) {
+        Some((_, e)) => {
+            for c in 0..3 {
+                e[c] += x[c];
+            }
+        }
+        None => field.push((b as u32, x)),
+    }
+}
+
+/// The emitted part of an element's radiosity at the top level (its area-weighted mean
+/// emission): which share of a link's light came straight from an emitter.
+struct EmittedShare<'a> {
+    /// Emitting polygons: their place in the hierarchy's cluster order and their `A·E`.
+    emitters: Vec<(usize, [f64; 3])>,
+    emission: &'a [[f64; 3]],
+}
+
+impl<'a> EmittedShare<'a> {
+    fn new(h: &Hierarchy, emission: &'a [[f64; 3]]) -> EmittedShare<'a> {
+        let emitters = h
+            .cluster_polygons
+            .iter()
+            .enumerate()
+            .filter_map(|(pos, &p)| {
+                let e = emission[p as usize];
+                e.iter().any(|&x| x > 0.0).then(|| (pos, e.map(|x| x * h.get(p).area)))
+            })
+            .collect();
+        EmittedShare { emitters, emission }
+    }
+
+    fn of(&self, h: &Hierarchy, e: ElementId) -> [f64; 3] {
+        let el = h.get(e);
+        match el.kind {
+            crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
+                let mut sum = [0.0; 3];
+                for (pos, ae) in &self.emitters {
+                    if (poly_start as usize..poly_end as usize).contains(pos) {
+                        for c in 0..3 {
+                            sum[c] += ae[c];
+                        }
+                    }
+                }
+                sum.map(|x| if el.area > 0.0 { x / el.area } else { 0.0 })
+            }
+            _ => el.polygon().map_or([0.0; 3], |p| self.emission[p as usize]),
+        }
+    }
+}
+
+/// A field split into the light straight from the top level's emitters and the rest, with the
+/// direct light ray traced to the level's own polygons.
+struct DirectSplit {
+    /// The field less its direct part.
+    rest: Vec<[f64; 3]>,
+    /// The direct part, per direction bin (what proxy faces receive and pass on).
+    direct: Vec<[f64; 3]>,
+    /// Traced direct irradiance per own polygon, by flattened index relative to the instance's
+    /// first (a transmitting leaf's back side at the index after its front).
+    traced: Vec<[f64; 3]>,
+}
+
+/// Direct irradiance of the `own` polygons of a level (scene frame) from `emitters`, ray traced
+/// through `caster` from [`InstancedConfig::direct_samples`] point pairs per polygon and emitter,
+/// by flattened index relative to `flat_base` (see [`DirectSplit::traced`]). A transmitting leaf's
+/// two sides are estimated from one set of pairs. Seeded by flattened index.
+fn traced_direct(
+    scene: &InstancedScene,
+    own: &[OwnPolygon],
+    flat_base: u64,
+    emitters: &[(Poly, [f64; 3])],
+    caster: &super::InstanceCaster,
+    samples: u32,
+) -> Vec<[f64; 3]> {
+    use rayon::prelude::*;
+    let sides: Vec<(usize, [f64; 3], [f64; 3])> = own
+        .par_iter()
+        .map(|(p, material, flat, _)| {
+            let two_sided = scene.materials[*material as usize].two_sided;
+            let (mut front, mut back) = ([0.0; 3], [0.0; 3]);
+            for (k, (q, e)) in emitters.iter().enumerate() {
+                let mut rng = crate::visibility::Rng::for_link(DIRECT_SEED ^ flat.wrapping_mul(0x9E37_79B9_7F4A_7C15), k as u32, 0);
+                let [f, g] = crate::solve::emitter_exchange(p, q, samples, &mut rng, two_sided, |x, y| caster.segment_clear(x, y));
+                for c in 0..3 {
+                    front[c] += f * e[c];
+                    back[c] += g * e[c];
+                }
+            }
+            ((flat - flat_base) as usize, front, back)
+        })
+        .collect();
+    let len = sides.iter().map(|s| s.0 + 2).max().unwrap_or(0);
+    let mut out = vec![[0.0; 3]; len];
+    for (k, front, back) in sides {
+        out[k] = front;
+        out[k + 1] = back;
+    }
+    out
+}
+
+/// Seed of the point pairs of [`traced_direct`].
+const DIRECT_SEED: u64 = 0xD1EC7;
 
 fn proxy_of(local: &Aabb, props: &RadiativeProperties) -> Proxy {
     let (c, half) = padded_half(local);

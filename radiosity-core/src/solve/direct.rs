@@ -7,7 +7,7 @@
 //! no hierarchy, no links, no clusters, so a solution that falls below the bound by more than the
 //! estimate's noise has lost light somewhere in its approximations.
 
-use crate::geom::DVec3;
+use crate::geom::{DVec3, Poly};
 use crate::hierarchy::NONE;
 use crate::scene::Scene;
 use crate::visibility::{RayCaster, Rng};
@@ -23,27 +23,15 @@ pub fn direct_irradiance(scene: &Scene, caster: &RayCaster, polygons: &[u32], sa
         .par_iter()
         .map(|&i| {
             let p = &scene.polygons[i as usize].poly;
-            let normal = p.normal();
             let mut h = [0.0; 3];
             for &l in &emitters {
                 if l == i {
                     continue;
                 }
                 let q = &scene.polygons[l as usize].poly;
-                let (nl, e) = (q.normal(), scene.material_of(l as usize).emission);
+                let e = scene.material_of(l as usize).emission;
                 let mut rng = Rng::for_link(seed, i, l);
-                let mut acc = 0.0;
-                for _ in 0..n {
-                    let x = p.sample(rng.next_f64(), rng.next_f64());
-                    let y = q.sample(rng.next_f64(), rng.next_f64());
-                    let d: DVec3 = y - x;
-                    let r2 = d.length_squared();
-                    let kernel = normal.dot(d).max(0.0) * (-nl.dot(d)).max(0.0) / (r2 * r2);
-                    if kernel > 0.0 && kernel.is_finite() && caster.segment_clear(x, y, i, l) {
-                        acc += kernel;
-                    }
-                }
-                let f = acc * q.area() / (std::f64::consts::PI * f64::from(n));
+                let [f, _] = emitter_exchange(p, q, n, &mut rng, false, |x, y| caster.segment_clear(x, y, i, l));
                 for c in 0..3 {
                     h[c] += f * e[c];
                 }
@@ -51,6 +39,47 @@ pub fn direct_irradiance(scene: &Scene, caster: &RayCaster, polygons: &[u32], sa
             h
         })
         .collect()
+}
+
+/// The form factor from a polygon `p` to an emitter `q` (the irradiance per unit emitted
+/// radiosity), estimated from `n` point pairs: `(A_q / πn) ∑ cosθ cosθ' V / r²`, with `clear(x, y)`
+/// the visibility of the pair. The points are stratified on both polygons (`q` on an `m × m` grid
+/// when `n = m²`, else in one coordinate; `p` in one coordinate) and the strata paired by a random
+/// permutation, which keeps the estimate unbiased. Returned for `p`'s front side and, when
+/// `both_sides` (a transmitting leaf), for its back side from the same pairs (0 otherwise).
+pub fn emitter_exchange(p: &Poly, q: &Poly, n: u32, rng: &mut Rng, both_sides: bool, clear: impl Fn(DVec3, DVec3) -> bool) -> [f64; 2] {
+    let (normal, nq) = (p.normal(), q.normal());
+    let n = n.max(1);
+    let m = f64::from(n).sqrt().round() as u32;
+    let grid = m * m == n;
+    // A random pairing of the strata on `p` with those on `q` (Fisher–Yates).
+    let mut order: Vec<u32> = (0..n).collect();
+    for k in (1..n as usize).rev() {
+        order.swap(k, (rng.next_u64() % (k as u64 + 1)) as usize);
+    }
+    let mut acc = [0.0; 2];
+    for (k, &j) in order.iter().enumerate() {
+        let k = k as u32;
+        let x = p.sample((f64::from(j) + rng.next_f64()) / f64::from(n), rng.next_f64());
+        let y = if grid {
+            q.sample((f64::from(k % m) + rng.next_f64()) / f64::from(m), (f64::from(k / m) + rng.next_f64()) / f64::from(m))
+        } else {
+            q.sample(rng.next_f64(), (f64::from(k) + rng.next_f64()) / f64::from(n))
+        };
+        let d: DVec3 = y - x;
+        let r2 = d.length_squared();
+        let cos_q = (-nq.dot(d)).max(0.0);
+        let cos_p = normal.dot(d);
+        let side = usize::from(cos_p < 0.0);
+        if side == 1 && !both_sides {
+            continue;
+        }
+        let kernel = cos_p.abs() * cos_q / (r2 * r2);
+        if kernel > 0.0 && kernel.is_finite() && clear(x, y) {
+            acc[side] += kernel;
+        }
+    }
+    acc.map(|a| a * q.area() / (std::f64::consts::PI * f64::from(n)))
 }
 
 /// The lower bound `E + ρ·H_d + t·H_d(other side)` on the radiosity of each of `polygons`

@@ -11,7 +11,7 @@ mod gmres;
 mod leaf;
 mod operator;
 
-pub use direct::{direct_irradiance, direct_lower_bound};
+pub use direct::{direct_irradiance, direct_lower_bound, emitter_exchange};
 pub use estimate::{ESTIMATE_BUDGET, ESTIMATE_MAX_SAMPLES, error_estimate};
 pub use final_gather::final_gather;
 pub use gmres::{GmresResult, gmres};
