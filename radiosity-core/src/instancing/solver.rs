@@ -1250,10 +1250,12 @@ impl VisibilityTable {
     }
 }
 
-/// Irradiance from outside of every polygon of a level, per proxy face its share of each beam, and
-/// of that the part straight from the top level's emitters (empty without a `split`): the field's
-/// beams (see [`table_irradiance`]), except that with a `split` the own polygons get the traced
-/// direct light in place of the field's direct part.
+/// Irradiance from outside of every polygon of a level (see the module docs), per proxy face its
+/// share of each beam, and of that share the part straight from the top level's emitters (empty
+/// without a `split`). `field` is the irradiance perpendicular to each beam of `dirs` (taken into
+/// the level's frame), received where the table says the beam's direction leaves the level (and
+/// it misses the inherited `occluders`). With a `split`, the field's direct part reaches only the
+/// proxy faces as beams; the own polygons get the traced direct light in its place.
 #[allow(clippy::type_complexity)]
 fn outside_irradiance(
     polys: &[Poly],
@@ -1264,60 +1266,36 @@ fn outside_irradiance(
     roles: &[Role],
     occluders: &[Poly],
 ) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>, Vec<Vec<[f64; 3]>>) {
-    let Some(split) = split else {
-        let (external, bins) = table_irradiance(polys, table, dirs, field, roles, occluders);
-        return (external, bins, Vec::new());
+    let (rest, direct) = match split {
+        Some(split) => (&split.rest[..], Some(&split.direct[..])),
+        None => (field, None),
     };
-    let (mut external, mut bins) = table_irradiance(polys, table, dirs, &split.rest, roles, occluders);
-    let (beamed, direct_bins) = table_irradiance(polys, table, dirs, &split.direct, roles, occluders);
-    for (i, e) in external.iter_mut().enumerate() {
-        let add = match roles.get(i) {
-            Some(Role::Own(info)) => split.traced.get(info.flat_index as usize).copied().unwrap_or([0.0; 3]),
-            _ => beamed[i],
-        };
-        for c in 0..3 {
-            e[c] += add[c];
-        }
-    }
-    for (total, d) in bins.iter_mut().zip(&direct_bins) {
-        for (t, x) in total.iter_mut().zip(d) {
-            for c in 0..3 {
-                t[c] += x[c];
-            }
-        }
-    }
-    (external, bins, direct_bins)
-}
-
-/// Irradiance from outside of every polygon of a level (see the module docs): `field` is the
-/// irradiance perpendicular to each beam of `dirs` (taken into the level's frame), received where
-/// the table says the beam's direction leaves the level. For the proxy faces among `roles`, the
-/// share of each beam is returned too.
-fn table_irradiance(
-    polys: &[Poly],
-    table: &VisibilityTable,
-    dirs: &[DVec3],
-    field: &[[f64; 3]],
-    roles: &[Role],
-    occluders: &[Poly],
-) -> (Vec<[f64; 3]>, Vec<Vec<[f64; 3]>>) {
     let strongest = field.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max);
     let active: Vec<usize> =
         (0..dirs.len()).filter(|&b| field[b].iter().copied().fold(0.0, f64::max) > FIELD_REL_MIN * strongest).collect();
     let nearest: Vec<usize> = dirs.iter().map(|d| nearest_direction(&table.dirs, *d)).collect();
     let k = table.dirs.len();
     use rayon::prelude::*;
-    polys
+    let rows: Vec<([f64; 3], Vec<[f64; 3]>, Vec<[f64; 3]>)> = polys
         .par_iter()
         .enumerate()
         .map(|(i, p)| {
             let n = p.normal();
+            let own = match roles.get(i) {
+                Some(Role::Own(info)) => Some(*info),
+                _ => None,
+            };
             let keep = is_proxy(roles, i);
             // Points of the polygon from which the beams are tested against the occluders handed
             // down from the levels above (none for most instances).
             // Only occluders with a vertex in front of the polygon's plane can stop a beam it takes.
             let x0 = p.v[0];
-            let ahead: Vec<&Poly> = occluders.iter().filter(|o| o.vertices().iter().any(|v| n.dot(*v - x0) > 0.0)).collect();
+            // Own polygons that get traced direct light skip them: what is left of their beams
+            // is the dim indirect light. Measured on the age-30 tree (eps 0.05, 16 pairs): max
+            // error 4.35% in 7.3 s so; 4.30% in 9.6 s testing every polygon; 4.56% in 7.0 s
+            // testing none.
+            let tested = if split.is_some() && !keep { &[][..] } else { occluders };
+            let ahead: Vec<&Poly> = tested.iter().filter(|o| o.vertices().iter().any(|v| n.dot(*v - x0) > 0.0)).collect();
             let points: Vec<DVec3> = if ahead.is_empty() {
                 Vec::new()
             } else {
@@ -1329,11 +1307,14 @@ fn table_irradiance(
                     .collect()
             };
             let mut bins = if keep { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
+            let mut direct_bins = if keep && direct.is_some() { vec![[0.0; 3]; dirs.len()] } else { Vec::new() };
             let mut acc = [0.0; 3];
             for &b in &active {
                 let cos = n.dot(dirs[b]);
                 let clear = table.counts[i * k + nearest[b]];
-                if cos <= 0.0 || clear == 0 {
+                // The beam's direct part only matters to proxy faces.
+                let beam = if keep { field[b] } else { rest[b] };
+                if cos <= 0.0 || clear == 0 || beam.iter().all(|&x| x <= 0.0) {
                     continue;
                 }
                 let mut v = f64::from(clear) / f64::from(TABLE_RAYS);
@@ -1342,16 +1323,36 @@ fn table_irradiance(
                     v *= open as f64 / points.len() as f64;
                 }
                 for c in 0..3 {
-                    let e = field[b][c] * cos * v;
+                    let e = beam[c] * cos * v;
                     acc[c] += e;
                     if keep {
                         bins[b][c] += e;
+                        if let Some(direct) = direct {
+                            direct_bins[b][c] += direct[b][c] * cos * v;
+                        }
                     }
                 }
             }
-            (acc, bins)
+            if let (Some(info), Some(split)) = (own, split) {
+                let traced = split.traced.get(info.flat_index as usize).copied().unwrap_or([0.0; 3]);
+                for c in 0..3 {
+                    acc[c] += traced[c];
+                }
+            }
+            (acc, bins, direct_bins)
         })
-        .unzip()
+        .collect();
+    let mut external = Vec::with_capacity(rows.len());
+    let mut bins = Vec::with_capacity(rows.len());
+    let mut direct_bins = Vec::with_capacity(if split.is_some() { rows.len() } else { 0 });
+    for (e, b, d) in rows {
+        external.push(e);
+        bins.push(b);
+        if split.is_some() {
+            direct_bins.push(d);
+        }
+    }
+    (external, bins, direct_bins)
 }
 
 /// Adds `x` to bin `b` of a sparse field.
