@@ -147,7 +147,8 @@ impl InstanceCaster {
         let (la, lb) = (p.to_local(a), p.to_local(b));
         let d = lb - la;
         let len = d.length();
-        if !(len > 0.0) || !len.is_finite() {
+        // A zero-length or non-finite segment meets nothing.
+        if !len.is_finite() || len <= 0.0 {
             return true;
         }
         let eps = SEGMENT_END_EPS;
