@@ -1436,7 +1436,7 @@ fn traced_direct(
     samples: u32,
 ) -> Vec<[f64; 3]> {
     use rayon::prelude::*;
-    let sides: Vec<(usize, [f64; 3], [f64; 3])> = own
+    let sides: Vec<(usize, [f64; 3], Option<[f64; 3]>)> = own
         .par_iter()
         .map(|(p, material, flat, _)| {
             let two_sided = scene.materials[*material as usize].two_sided;
@@ -1449,14 +1449,16 @@ fn traced_direct(
                     back[c] += g * e[c];
                 }
             }
-            ((flat - flat_base) as usize, front, back)
+            ((flat - flat_base) as usize, front, two_sided.then_some(back))
         })
         .collect();
     let len = sides.iter().map(|s| s.0 + 2).max().unwrap_or(0);
     let mut out = vec![[0.0; 3]; len];
     for (k, front, back) in sides {
         out[k] = front;
-        out[k + 1] = back;
+        if let Some(back) = back {
+            out[k + 1] = back;
+        }
     }
     out
 }
