@@ -33,10 +33,10 @@ impl ShaftObjects {
         }
         match self.volume {
             BoundingVolume::Aabb => true,
-            BoundingVolume::Obb => may_intersect_obb(shaft, &o.obb),
+            BoundingVolume::Obb => !o.oriented || may_intersect_obb(shaft, &o.obb),
             BoundingVolume::Hull => match self.hull_of(id) {
                 Some(points) => shaft.may_intersect_points(points),
-                None => may_intersect_obb(shaft, &o.obb),
+                None => !o.oriented || may_intersect_obb(shaft, &o.obb),
             },
         }
     }
@@ -65,7 +65,8 @@ impl ShaftObjects {
             let lowest = match (self.volume, hull) {
                 (BoundingVolume::Aabb, _) => lowest,
                 (BoundingVolume::Hull, Some(points)) => lowest.max(pl.min_over_points(points)),
-                (BoundingVolume::Obb | BoundingVolume::Hull, _) => lowest.max(o.obb.min_along(pl)),
+                (BoundingVolume::Obb | BoundingVolume::Hull, _) if o.oriented => lowest.max(o.obb.min_along(pl)),
+                (BoundingVolume::Obb | BoundingVolume::Hull, _) => lowest,
             };
             depth = depth.min(pl.offset - lowest);
         }

@@ -30,7 +30,7 @@ pub use build::{MAX_SIDE_PLANES, SHAFT_REL_TOL, Shaft, ShaftKind};
 pub use classify::{GRAZE_REL_TOL, ShaftClass, ShaftVerdict, classify, classify_with, element_vertices, occludes, shaft_of};
 pub use cull::{may_intersect_aabb, may_intersect_obb};
 pub use merge::{COPLANAR_REL_TOL, MergedPlate};
-pub use obb::Obb;
+pub use obb::{AXIS_ALIGNED_TOL, Obb};
 pub use objects::{BoundingVolume, ConvexSolid, ObjectConfig, SOLID_REL_TOL, ShaftObject, ShaftObjects};
 pub use occlusion::{OCCLUSION_REL_TOL, convex_polygon_occludes, plate_occludes, solid_occludes};
 pub use plane::{Plane, aabb_corners};

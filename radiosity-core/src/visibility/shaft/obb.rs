@@ -22,6 +22,10 @@ const RANK_PAD_REL: f64 = 1e-3;
 /// Most faces of an object whose frames are tried when tightening.
 const MAX_FACE_FRAMES: usize = 8;
 
+/// How far from 1 the largest component of a unit axis may be for the axis to count as a world
+/// axis ([`Obb::is_axis_aligned`]).
+pub const AXIS_ALIGNED_TOL: f64 = 1e-12;
+
 impl Obb {
     /// The box with the world axes that equals `b`.
     #[must_use]
@@ -73,6 +77,13 @@ impl Obb {
             }
         }
         best
+    }
+
+    /// Whether every axis is a world axis (up to [`AXIS_ALIGNED_TOL`]): the box is then its own
+    /// AABB.
+    #[must_use]
+    pub fn is_axis_aligned(&self) -> bool {
+        self.axes.iter().all(|a| a.abs().max_element() >= 1.0 - AXIS_ALIGNED_TOL)
     }
 
     /// The 8 corners.

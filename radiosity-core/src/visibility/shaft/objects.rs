@@ -68,6 +68,9 @@ pub struct ShaftObject {
     pub aabb: Aabb,
     /// Oriented bounding box.
     pub obb: Obb,
+    /// Whether the OBB is turned away from the world axes; when it is not, it is the AABB and the
+    /// OBB tests are skipped (on axis-aligned scenes OBB culling then costs what AABB culling does).
+    pub oriented: bool,
     poly_range: (u32, u32),
     hull_range: Option<(u32, u32)>,
     merged_range: (u32, u32),
@@ -179,6 +182,7 @@ impl ShaftObjects {
         self.objects.push(ShaftObject {
             group,
             aabb,
+            oriented: !obb.is_axis_aligned(),
             obb,
             poly_range: (start, self.object_polygons.len() as u32),
             hull_range,
