@@ -61,6 +61,10 @@ pub const RECULL_SHRINK: f64 = 0.5;
 /// Inherited lists longer than this (objects) count as long for [`RECULL_SHRINK`].
 pub const LONG_LIST_OBJECTS: usize = 4;
 
+/// Candidates evaluated per parallel batch by [`refine`] (the outcomes of one batch are held at a
+/// time).
+pub const EVALUATE_BATCH: usize = 16_384;
+
 enum Outcome {
     Keep(Link, bool),
     Split(Decision, Option<Arc<[u32]>>, f64),
@@ -99,33 +103,43 @@ pub fn refine(
             .collect()
     };
     let mut out = Vec::with_capacity(links.len().max(1024));
+    drop(links);
     while !pending.is_empty() {
-        let outcomes: Vec<Outcome> = {
-            let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref, shafts };
-            pending.par_iter().map(|c| evaluate(&services, oracle, c)).collect()
-        };
-        let mut next = Vec::new();
-        for (c, outcome) in pending.iter().zip(outcomes) {
-            match outcome {
-                Outcome::Keep(link, computed) => {
-                    stats.oracle_calls += u64::from(c.source != c.receiver);
-                    stats.form_factors += u64::from(computed);
-                    if link.ff * link.vis > MIN_LINK_FORM_FACTOR || c.existing.is_some() {
-                        out.push(link);
-                    } else {
-                        stats.dropped += 1;
+        // Every candidate of the wave is evaluated against the hierarchy as it was before the
+        // wave, in parallel batches; kept links go out at once (they do not touch the
+        // hierarchy), and the splits are applied afterwards, in candidate order. Holding one
+        // batch's outcomes instead of the wave's keeps the peak memory of a large local problem
+        // down (the top level of a forest: 137,000 links re-examined per pass).
+        let mut splits: Vec<(ElementId, ElementId, Decision, Option<Arc<[u32]>>, f64)> = Vec::new();
+        for batch in pending.chunks(EVALUATE_BATCH) {
+            let outcomes: Vec<Outcome> = {
+                let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref, shafts };
+                batch.par_iter().map(|c| evaluate(&services, oracle, c)).collect()
+            };
+            for (c, outcome) in batch.iter().zip(outcomes) {
+                stats.oracle_calls += u64::from(c.source != c.receiver);
+                match outcome {
+                    Outcome::Keep(link, computed) => {
+                        stats.form_factors += u64::from(computed);
+                        if link.ff * link.vis > MIN_LINK_FORM_FACTOR || c.existing.is_some() {
+                            out.push(link);
+                        } else {
+                            stats.dropped += 1;
+                        }
+                    }
+                    Outcome::Drop => stats.dropped += 1,
+                    Outcome::Split(d, cands, culled_diag) => {
+                        stats.subdivided += 1;
+                        splits.push((c.source, c.receiver, d, cands, culled_diag));
                     }
                 }
-                Outcome::Drop => {
-                    stats.oracle_calls += u64::from(c.source != c.receiver);
-                    stats.dropped += 1;
-                }
-                Outcome::Split(d, cands, culled_diag) => {
-                    stats.oracle_calls += u64::from(c.source != c.receiver);
-                    stats.subdivided += 1;
-                    split(h, radiosity, c, d, cands, culled_diag, &mut next);
-                }
             }
+        }
+        drop(pending);
+        let mut next = Vec::new();
+        for (source, receiver, d, cands, culled_diag) in splits {
+            let c = Candidate { source, receiver, existing: None, cands: None, culled_diag };
+            split(h, radiosity, &c, d, cands, culled_diag, &mut next);
         }
         pending = next;
         progress(out.len() as u64, pending.len() as u64);
