@@ -65,6 +65,10 @@ pub const LONG_LIST_OBJECTS: usize = 4;
 /// time).
 pub const EVALUATE_BATCH: usize = 16_384;
 
+/// A split decided during a wave, applied after it: source, receiver, decision, the candidates
+/// its children inherit and the diagonal they were culled for.
+type PendingSplit = (ElementId, ElementId, Decision, Option<Arc<[u32]>>, f64);
+
 enum Outcome {
     Keep(Link, bool),
     Split(Decision, Option<Arc<[u32]>>, f64),
@@ -110,7 +114,7 @@ pub fn refine(
         // hierarchy), and the splits are applied afterwards, in candidate order. Holding one
         // batch's outcomes instead of the wave's keeps the peak memory of a large local problem
         // down (the top level of a forest: 137,000 links re-examined per pass).
-        let mut splits: Vec<(ElementId, ElementId, Decision, Option<Arc<[u32]>>, f64)> = Vec::new();
+        let mut splits: Vec<PendingSplit> = Vec::new();
         for batch in pending.chunks(EVALUATE_BATCH) {
             let outcomes: Vec<Outcome> = {
                 let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref, shafts };
