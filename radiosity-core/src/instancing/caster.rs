@@ -13,6 +13,7 @@
 
 use super::model::{InstancedScene, PrototypeId};
 use crate::geom::{Aabb, DVec3};
+use crate::visibility::BvhFrame;
 use crate::visibility::SEGMENT_END_EPS;
 use glam::{DMat4, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::Ray, triangle::Triangle};
@@ -44,15 +45,7 @@ struct PrototypeBvh {
     bvh: CwBvh,
     /// Primitives in the BVH's order.
     primitives: Vec<Primitive>,
-    center: DVec3,
-    inv_scale: f64,
-}
-
-impl PrototypeBvh {
-    fn to_local(&self, p: DVec3) -> Vec3A {
-        let q = (p - self.center) * self.inv_scale;
-        Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
-    }
+    frame: BvhFrame,
 }
 
 /// Segment tests against an instanced scene through its nested per-prototype BVHs. Casts are not
@@ -79,13 +72,8 @@ impl InstanceCaster {
                 if b.is_empty() {
                     return None;
                 }
-                let center = b.center();
-                let diag = b.diagonal();
-                let inv_scale = if diag > 0.0 { 1.0 / diag } else { 1.0 };
-                let frame = |v: DVec3| {
-                    let q = (v - center) * inv_scale;
-                    Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
-                };
+                let bvh_frame = BvhFrame::of(b);
+                let frame = |v: DVec3| bvh_frame.point(v);
                 let mut primitives = Vec::new();
                 for q in &p.polygons {
                     let v = q.poly.vertices();
@@ -114,7 +102,7 @@ impl InstanceCaster {
                 let mut core_time = std::time::Duration::ZERO;
                 let bvh = build_cwbvh(&primitives, BvhBuildParams::medium_build(), &mut core_time);
                 let primitives = bvh.primitive_indices.iter().map(|&i| primitives[i as usize]).collect();
-                Some(PrototypeBvh { bvh, primitives, center, inv_scale })
+                Some(PrototypeBvh { bvh, primitives, frame: bvh_frame })
             })
             .collect();
         InstanceCaster { prototypes, root: scene.root }
@@ -144,7 +132,7 @@ impl InstanceCaster {
     /// [`Self::segment_clear`] in the frame of `prototype` (its local coordinates).
     fn clear_in(&self, prototype: PrototypeId, a: DVec3, b: DVec3) -> bool {
         let Some(p) = &self.prototypes[prototype as usize] else { return true };
-        let (la, lb) = (p.to_local(a), p.to_local(b));
+        let (la, lb) = (p.frame.point(a), p.frame.point(b));
         let d = lb - la;
         let len = d.length();
         // A zero-length or non-finite segment meets nothing.

@@ -8,4 +8,5 @@
 mod rays;
 pub mod shaft;
 
+pub(crate) use rays::BvhFrame;
 pub use rays::{KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, sampled_visibility};

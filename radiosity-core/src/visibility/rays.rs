@@ -77,9 +77,31 @@ pub struct RayCaster {
     triangles: Vec<Triangle>,
     /// Input polygon of each triangle, in BVH primitive order.
     tri_polygon: Vec<u32>,
-    center: DVec3,
-    inv_scale: f64,
+    frame: BvhFrame,
     rays_cast: RayCount,
+}
+
+/// The normalised frame an `f32` BVH is built in: centred on the bounds, diagonal 1, so that
+/// `f32` keeps its precision (and obvhs's fixed node epsilon its meaning) at any scene scale.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BvhFrame {
+    center: DVec3,
+    /// 1 / the bounds' diagonal (1 for empty or point bounds): frame lengths over this are
+    /// scene lengths.
+    pub(crate) inv_scale: f64,
+}
+
+impl BvhFrame {
+    pub(crate) fn of(bounds: &crate::geom::Aabb) -> BvhFrame {
+        let diag = bounds.diagonal();
+        BvhFrame { center: bounds.center(), inv_scale: if diag > 0.0 { 1.0 / diag } else { 1.0 } }
+    }
+
+    /// `p` (scene coordinates) in the frame, in `f32`.
+    pub(crate) fn point(&self, p: DVec3) -> Vec3A {
+        let q = (p - self.center) * self.inv_scale;
+        Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
+    }
 }
 
 /// A count of rays cast from many threads: one cache-line-sized slot per worker thread, so that
@@ -117,13 +139,8 @@ impl RayCaster {
     #[must_use]
     pub fn new(scene: &Scene) -> RayCaster {
         let bounds = scene.bounds();
-        let center = bounds.center();
-        let diag = bounds.diagonal();
-        let inv_scale = if diag > 0.0 { 1.0 / diag } else { 1.0 };
-        let to_f32 = |p: DVec3| {
-            let q = (p - center) * inv_scale;
-            Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
-        };
+        let frame = BvhFrame::of(&bounds);
+        let to_f32 = |p: DVec3| frame.point(p);
         let mut tris = Vec::with_capacity(scene.polygons.len() * 2);
         let mut owner = Vec::with_capacity(scene.polygons.len() * 2);
         for (i, p) in scene.polygons.iter().enumerate() {
@@ -138,7 +155,7 @@ impl RayCaster {
             if tris.is_empty() { CwBvh::default() } else { build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core_time) };
         // Reorder triangles into BVH primitive order so the callback indexes them directly.
         let (triangles, tri_polygon) = bvh.primitive_indices.iter().map(|&i| (tris[i as usize], owner[i as usize])).unzip();
-        RayCaster { bvh, triangles, tri_polygon, center, inv_scale, rays_cast: RayCount::new() }
+        RayCaster { bvh, triangles, tri_polygon, frame, rays_cast: RayCount::new() }
     }
 
     /// Number of rays cast so far.
@@ -148,8 +165,7 @@ impl RayCaster {
     }
 
     fn to_local(&self, p: DVec3) -> Vec3A {
-        let q = (p - self.center) * self.inv_scale;
-        Vec3A::new(q.x as f32, q.y as f32, q.z as f32)
+        self.frame.point(p)
     }
 
     /// True when the open segment `a`–`b` meets no triangle other than those of polygons `skip_a`, `skip_b`.
@@ -186,7 +202,7 @@ impl RayCaster {
         let ray = Ray::new(self.to_local(origin), ray_direction(dir), 0.0, f32::INFINITY);
         let mut hit = obvhs::ray::RayHit::none();
         if self.bvh.ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray)) {
-            Some((hit.t as f64 / self.inv_scale, self.tri_polygon[hit.primitive_id as usize]))
+            Some((hit.t as f64 / self.frame.inv_scale, self.tri_polygon[hit.primitive_id as usize]))
         } else {
             None
         }
