@@ -68,3 +68,21 @@ fn the_shaft_oracle_gets_shafts_from_a_default_pipeline() {
     let solved = pipeline::run(&scene, shaft.as_ref(), &Config::default(), &|_| {});
     assert!(solved.shaft_classified.iter().sum::<u64>() > 0, "no shaft was classified");
 }
+
+/// The shaft oracle's graph run by the DAG runtime (its shaft tools are built-ins) needs shafts
+/// as the macro's release does and makes the same links and the same solution.
+#[test]
+fn the_dag_runtime_runs_the_shaft_oracle_as_the_macro_does() {
+    use radiosity::oracle::runtime::DagOracle;
+    use radiosity::refine::Oracle;
+    let scene = duplex();
+    let release = ShaftOracle::new(ShaftOracleParams::default());
+    let dag = DagOracle::new(ShaftOracle::<radiosity::oracle::NoProbe>::GRAPH, &[]).expect("built-in tools only");
+    assert!(dag.needs().shafts, "the interpreted graph needs shafts");
+    let (a, b) = (pipeline::run(&scene, &release, &Config::default(), &|_| {}), pipeline::run(&scene, &dag, &Config::default(), &|_| {}));
+    assert!(a.shaft_classified.iter().sum::<u64>() > 0);
+    assert_eq!(a.shaft_classified, b.shaft_classified);
+    assert_eq!(a.links.len(), b.links.len());
+    let (pa, pb) = (polygon_results(&a.hierarchy, &a.solution), polygon_results(&b.hierarchy, &b.solution));
+    assert!(pa.iter().zip(&pb).all(|(x, y)| x.b == y.b), "same decisions give the same solution");
+}

@@ -28,6 +28,8 @@ pub enum Slot {
     Axis,
     /// A mark left on the link.
     Mark,
+    /// The shaft classification and candidate occluders.
+    Shaft,
 }
 
 impl Slot {
@@ -41,6 +43,7 @@ impl Slot {
             Slot::Visibility => "visibility",
             Slot::Axis => "axis",
             Slot::Mark => "mark",
+            Slot::Shaft => "shaft",
         }
     }
 }
@@ -125,6 +128,22 @@ pub const BUILTIN_TOOLS: &[ToolInfo] = &[
         args: &[],
         slots: &[Slot::Visibility],
         doc: "exact-as-possible visibility class (many rays), the reference of visibility studies",
+    },
+    ToolInfo {
+        name: "ShaftClassify",
+        kind: ToolKind::Question,
+        answers: &["Invisible", "Visible", "Partial"],
+        args: &[],
+        slots: &[Slot::Shaft],
+        doc: "the link's shaft: one occluder blocks it whole, nothing enters it, or something may occlude (needs shafts)",
+    },
+    ToolInfo {
+        name: "ShaftFfError",
+        kind: ToolKind::Question,
+        answers: &["Above", "Below"],
+        args: &[ArgSpec { name: "eps", ty: F64 }],
+        slots: &[Slot::FormFactorMax, Slot::FormFactorRange, Slot::Shaft],
+        doc: "is B_S · (F_max - F_min) above eps · B_ref, F_min = 0 unless the shaft is empty (needs shafts)",
     },
     ToolInfo {
         name: "Facing",

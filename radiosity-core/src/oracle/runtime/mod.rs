@@ -163,6 +163,10 @@ impl<P: Probe> Oracle for DagOracle<P> {
         &self.graph.name
     }
 
+    fn needs(&self) -> crate::refine::Needs {
+        self.nodes.iter().fold(crate::refine::Needs::NONE, |n, node| n.union(node.tool.needs()))
+    }
+
     fn decide(&self, ctx: &mut LinkCtx<'_>) -> Decision {
         let mut next = self.start;
         loop {

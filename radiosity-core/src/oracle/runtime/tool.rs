@@ -14,6 +14,8 @@ pub enum DynTool {
     FfGradient(FfGradient),
     RayVisibility(RayVisibility),
     ReferenceVisibility(ReferenceVisibility),
+    ShaftClassify(ShaftClassify),
+    ShaftFfError(ShaftFfError),
     Facing(Facing),
     ClusterTooNear(ClusterTooNear),
     CanSubdivide(CanSubdivide),
@@ -25,6 +27,10 @@ pub enum DynTool {
     PreciseVisibility(PreciseVisibility),
     PreciseFormFactor(PreciseFormFactor),
     Mark(Mark),
+}
+
+fn needs<T: Tool>(_: &T) -> crate::refine::Needs {
+    T::NEEDS
 }
 
 #[inline]
@@ -46,6 +52,8 @@ impl DynTool {
             "FfGradient" => DynTool::FfGradient(FfGradient(f(0))),
             "RayVisibility" => DynTool::RayVisibility(RayVisibility(u(0))),
             "ReferenceVisibility" => DynTool::ReferenceVisibility(ReferenceVisibility),
+            "ShaftClassify" => DynTool::ShaftClassify(ShaftClassify),
+            "ShaftFfError" => DynTool::ShaftFfError(ShaftFfError(f(0))),
             "Facing" => DynTool::Facing(Facing),
             "ClusterTooNear" => DynTool::ClusterTooNear(ClusterTooNear),
             "CanSubdivide" => DynTool::CanSubdivide(CanSubdivide(f(0))),
@@ -70,6 +78,8 @@ impl DynTool {
             DynTool::FfGradient(t) => ask(t, ctx),
             DynTool::RayVisibility(t) => ask(t, ctx),
             DynTool::ReferenceVisibility(t) => ask(t, ctx),
+            DynTool::ShaftClassify(t) => ask(t, ctx),
+            DynTool::ShaftFfError(t) => ask(t, ctx),
             DynTool::Facing(t) => ask(t, ctx),
             DynTool::ClusterTooNear(t) => ask(t, ctx),
             DynTool::CanSubdivide(t) => ask(t, ctx),
@@ -84,6 +94,31 @@ impl DynTool {
         }
     }
 
+    /// The pipeline services the tool needs ([`Tool::NEEDS`]).
+    #[must_use]
+    pub fn needs(&self) -> crate::refine::Needs {
+        match self {
+            DynTool::BfAbove(t) => needs(t),
+            DynTool::IrradianceChange(t) => needs(t),
+            DynTool::FfGradient(t) => needs(t),
+            DynTool::RayVisibility(t) => needs(t),
+            DynTool::ReferenceVisibility(t) => needs(t),
+            DynTool::ShaftClassify(t) => needs(t),
+            DynTool::ShaftFfError(t) => needs(t),
+            DynTool::Facing(t) => needs(t),
+            DynTool::ClusterTooNear(t) => needs(t),
+            DynTool::CanSubdivide(t) => needs(t),
+            DynTool::Larger(t) => needs(t),
+            DynTool::SplitFirst(t) => needs(t),
+            DynTool::PlanesIntersect(t) => needs(t),
+            DynTool::ProjectedAreaBelow(t) => needs(t),
+            DynTool::NormalCone(t) => needs(t),
+            DynTool::PreciseVisibility(t) => needs(t),
+            DynTool::PreciseFormFactor(t) => needs(t),
+            DynTool::Mark(t) => needs(t),
+        }
+    }
+
     /// Variant names of the tool `name`'s answer enum (for checking the catalogue).
     #[must_use]
     pub fn answer_names(name: &str) -> Option<&'static [&'static str]> {
@@ -93,6 +128,8 @@ impl DynTool {
             "FfGradient" => FfSpread::NAMES,
             "RayVisibility" => VisibilityClass::NAMES,
             "ReferenceVisibility" => ReferenceClass::NAMES,
+            "ShaftClassify" => ShaftAnswer::NAMES,
+            "ShaftFfError" => FfError::NAMES,
             "CanSubdivide" => Subdividable::NAMES,
             "Larger" | "SplitFirst" => Side::NAMES,
             "NormalCone" => Cone::NAMES,

@@ -4,6 +4,7 @@
 mod command;
 mod energy;
 mod geometry;
+mod shaft;
 mod visibility;
 
 pub use command::{Done, Mark, PreciseFormFactor, PreciseVisibility};
@@ -12,4 +13,5 @@ pub use geometry::{
     CanSubdivide, ClusterTooNear, Cone, Facing, Larger, NormalCone, PlanesIntersect, ProjectedAreaBelow, Side, SplitFirst, Subdividable,
     YesNo,
 };
+pub use shaft::{FfError, ShaftAnswer, ShaftClassify, ShaftFfError};
 pub use visibility::{PROBABLE_BELOW_RAYS, REFERENCE_RAYS, RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};

@@ -1,0 +1,64 @@
+//! Shaft questions (Haines & Wallace shafts): the link's shaft classification and the form factor
+//! error bounded with it. Both need shaft culling ([`crate::refine::Needs::SHAFTS`]), which
+//! [`crate::pipeline::run`] turns on for any oracle that asks them.
+
+use crate::oracle::Tool;
+use crate::refine::LinkCtx;
+use crate::visibility::shaft::ShaftClass;
+
+crate::answer_enum! {
+    /// Answer of [`ShaftClassify`].
+    pub enum ShaftAnswer {
+        /// One candidate blocks every segment between the elements.
+        Invisible,
+        /// No object enters the shaft.
+        Visible,
+        /// Some object enters the shaft and none is known to block it whole.
+        Partial,
+    }
+}
+
+/// Classifies the link by its shaft (memoised in the link context, candidates inherited from the
+/// parent link). Partial when shaft culling is off.
+#[derive(Clone, Copy, Debug)]
+pub struct ShaftClassify;
+
+impl Tool for ShaftClassify {
+    type Answer = ShaftAnswer;
+    const NEEDS: crate::refine::Needs = crate::refine::Needs::SHAFTS;
+    fn ask(&self, ctx: &mut LinkCtx<'_>) -> ShaftAnswer {
+        match ctx.shaft_verdict() {
+            Some(ShaftClass::Invisible) => ShaftAnswer::Invisible,
+            Some(ShaftClass::Visible) => ShaftAnswer::Visible,
+            Some(ShaftClass::Partial { .. }) | None => ShaftAnswer::Partial,
+        }
+    }
+}
+
+crate::answer_enum! {
+    /// Answer of [`ShaftFfError`].
+    pub enum FfError {
+        /// `B_S · (F_max − F_min)` exceeds the threshold.
+        Above,
+        /// It does not.
+        Below,
+    }
+}
+
+/// Is `B_S · (F_max − F_min) > eps · B_ref`? `F_min` is the smallest point form factor over the
+/// receiver when the shaft is empty, and 0 when some candidate may occlude.
+#[derive(Clone, Copy, Debug)]
+pub struct ShaftFfError(pub f64);
+
+impl Tool for ShaftFfError {
+    type Answer = FfError;
+    const NEEDS: crate::refine::Needs = crate::refine::Needs::SHAFTS;
+    fn ask(&self, ctx: &mut LinkCtx<'_>) -> FfError {
+        let f_max = ctx.form_factor_max();
+        let f_min = match ctx.shaft_verdict() {
+            Some(ShaftClass::Visible) => ctx.form_factor_range().0.min(f_max),
+            _ => 0.0,
+        };
+        if ctx.emitter_radiosity() * (f_max - f_min) > self.0 * ctx.services.b_ref { FfError::Above } else { FfError::Below }
+    }
+}
