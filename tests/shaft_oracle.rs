@@ -86,3 +86,17 @@ fn the_dag_runtime_runs_the_shaft_oracle_as_the_macro_does() {
     let (pa, pb) = (polygon_results(&a.hierarchy, &a.solution), polygon_results(&b.hierarchy, &b.solution));
     assert!(pa.iter().zip(&pb).all(|(x, y)| x.b == y.b), "same decisions give the same solution");
 }
+
+/// `oracle explain shaft` shows the shaft's class and candidate count in the track. On the Cornell
+/// box the link from element 0 to element 23 is one the oracle classifies (partial) and splits.
+#[test]
+fn the_explained_track_shows_the_shaft() {
+    use radiosity::oracle::{registry, runtime::format_trace};
+    let scene = radiosity::scene::cornell_box();
+    let (graph, trace) = registry::explain("shaft", &[], &scene, &Config::default(), 0, 23).expect("built-in oracle");
+    assert!(!trace.is_empty(), "the pair 0 -> 23 was asked");
+    let text = format_trace(&graph, &trace);
+    let shaft_step = trace.iter().find(|s| graph.nodes[s.node].tool.name == "ShaftClassify").expect("the shaft was classified");
+    assert!(shaft_step.shaft.is_some(), "{text}");
+    assert!(text.contains("shaft=partial ("), "{text}");
+}

@@ -46,6 +46,8 @@ pub struct TraceStep {
     pub answer: &'static str,
     /// The link data after the tool ran: the values it used or computed.
     pub data: LinkData,
+    /// The link's shaft classification and candidate count, once a tool classified it.
+    pub shaft: Option<(crate::visibility::shaft::ShaftClass, usize)>,
     /// Time spent in the tool, nanoseconds.
     pub nanos: u64,
 }
@@ -155,7 +157,8 @@ impl Probe for Recorder {
         if self.pair == Some((ctx.emitter, ctx.receiver))
             && let Ok(mut t) = self.trace.lock()
         {
-            t.push(TraceStep { node, answer: names.get(answer).copied().unwrap_or("?"), data: ctx.data, nanos });
+            let shaft = ctx.shaft.as_ref().map(|(class, candidates)| (*class, candidates.len()));
+            t.push(TraceStep { node, answer: names.get(answer).copied().unwrap_or("?"), data: ctx.data, shaft, nanos });
         }
     }
 }

@@ -18,6 +18,9 @@ pub struct StatsTimes {
     pub output: f64,
     /// Everything.
     pub total: f64,
+    /// Solves timed: build, refine and solve are the fastest of them (1 unless `solve --time-for`
+    /// asked for more).
+    pub runs: u32,
 }
 
 /// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
@@ -134,6 +137,7 @@ impl Stats {
                 solve: solved.timings.solve,
                 output,
                 total,
+                runs: 1,
             },
             peak_rss_bytes: peak_rss_bytes(),
             left_out: solved.left_out.clone(),

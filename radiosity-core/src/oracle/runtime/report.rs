@@ -1,6 +1,7 @@
 //! Text and DOT renderings of what a [`crate::oracle::Recorder`] gathered.
 
 use crate::oracle::{NodeStats, TraceStep};
+use crate::visibility::shaft::ShaftClass;
 use oracle_graph::Graph;
 use std::fmt::Write;
 
@@ -29,6 +30,14 @@ pub fn format_trace(graph: &Graph, trace: &[TraceStep]) -> String {
         }
         if let Some(m) = d.mark {
             values.push(format!("mark={m}"));
+        }
+        if let Some((class, candidates)) = step.shaft {
+            let class = match class {
+                ShaftClass::Invisible => "invisible",
+                ShaftClass::Visible => "visible",
+                ShaftClass::Partial { .. } => "partial",
+            };
+            values.push(format!("shaft={class} ({candidates} candidates)"));
         }
         let next = node.arms.iter().find(|a| a.answers.iter().any(|x| x == step.answer)).map_or("?", |a| a.target.word());
         let _ = writeln!(
