@@ -9,12 +9,13 @@
 //! configuration asks for plain rays.
 //!
 //! One step comes before the shaft: when `B_S · F_max` alone (the error with `F_min = 0`, the BF
-//! criterion [`crate::oracle::tools::BfAbove`]) is within the threshold, no classification can make the link's error larger, so the link is stored without
-//! one. The decisions are the paper's except for a link below the threshold that one occluder blocks
-//! whole: it is stored (its segments all come out blocked, so it carries nothing) instead of
-//! dropped. Measured with `radiosity bench shafts`: the step halves the oracle's refinement time on
-//! the duplex (4,681 → 4,684 links, solutions within 1.4e-6 of each other) and leaves sj-geometry's
-//! links unchanged.
+//! criterion [`crate::oracle::tools::BfAbove`]) is within the threshold, no classification can make
+//! the link's error larger, so the link is stored without one. The decisions are the paper's except
+//! for a link below the threshold that one occluder blocks whole: it goes to the driver as a link,
+//! which drops it when all its segments come out blocked, instead of being stopped by the shaft.
+//! Measured (callgrind, one thread, whole solve): the step takes the duplex from 1.22 G to 0.90 G
+//! instructions (4,681 → 4,684 links, solutions within 1.4e-6 of the largest radiosity) and
+//! sj-geometry from 0.56 G to 0.42 G (links unchanged).
 
 oracle_macros::oracle! {
     crate = crate;
