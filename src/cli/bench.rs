@@ -15,7 +15,8 @@ pub enum BenchCommand {
     /// and ratio to hand-written, and whether links and radiosity are identical.
     Oracle(OracleBenchArgs),
     /// Visibility by plain rays vs AABB and OBB shafts: links, elements, rays, time, peak RSS and the
-    /// largest difference to the rays solution, per scene.
+    /// largest difference to the rays solution, per scene; plain rays with the next seed give the
+    /// noise of both.
     Shafts(ShaftBenchArgs),
     /// A generated tree solved fully (flattened, with clustering) and by hierarchical
     /// instantiation, each in its own process: time, peak RSS, links, and the instanced solution's
@@ -34,8 +35,8 @@ pub struct ShaftBenchArgs {
     pub scenes: Vec<String>,
     #[command(flatten)]
     pub options: SolveOptions,
-    /// Solves per method and scene, interleaved (rays, aabb, obb, aabb/shaft, obb/shaft, rays, ...);
-    /// the fastest counts.
+    /// Rounds of solves per method and scene, interleaved (rays, aabb, obb, aabb/shaft, obb/shaft,
+    /// rays/seed+1, rays, ...); the fastest counts.
     #[arg(long, default_value_t = 3)]
     pub repeats: u32,
     /// Each solve after the first round is repeated within its process for this long (`solve
@@ -352,18 +353,23 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
     let tmp = std::env::temp_dir().join(format!("radiosity-bench-shafts-{}", std::process::id()));
     // (label, visibility, oracle): with `bf-hand` shafts only cull the rays (links as with plain
     // rays); with the shaft oracle they also decide refinement, so tighter culling means fewer
-    // links. The plain-rays reference uses `bf-hand`: the shaft oracle needs shafts.
-    const METHODS: [(&str, &str, &str); 5] = [
+    // links. The plain-rays reference uses `bf-hand`: the shaft oracle needs shafts. The last
+    // method is plain rays again with the next seed: its difference to the first is the ray
+    // sampling noise, its speed-up the timing noise.
+    const METHODS: [(&str, &str, &str); 6] = [
         ("rays", "rays", "bf-hand"),
         ("aabb", "aabb", "bf-hand"),
         ("obb", "obb", "bf-hand"),
         ("aabb/shaft", "aabb", "shaft"),
         ("obb/shaft", "obb", "shaft"),
+        ("rays/seed+1", "rays", "bf-hand"),
     ];
+    let mut reseeded = args.options.clone();
+    reseeded.common.seed = reseeded.common.seed.wrapping_add(1);
     let mut rows = Vec::new();
     if !args.json {
         println!(
-            "{:<18} {:<10} {:>9} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>8} {:>8} {:>6}",
+            "{:<18} {:<12} {:>9} {:>9} {:>11} {:>9} {:>9} {:>9} {:>10} {:>8} {:>8} {:>6}",
             "scene", "method", "links", "elements", "rays", "time_s", "refine_s", "peak_MB", "max_diff", "speedup", "refine", "runs"
         );
     }
@@ -375,7 +381,8 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
             let time_for = if r == 0 && args.repeats > 1 { 0.0 } else { args.time_for };
             for (m, &(_, visibility, oracle)) in METHODS.iter().enumerate() {
                 let out = tmp.join(format!("{i}-{m}"));
-                let mut s = child_solve(&exe, scene, &args.options, Some(visibility), Some(oracle), time_for, &out)?;
+                let options = if m + 1 == METHODS.len() { &reseeded } else { &args.options };
+                let mut s = child_solve(&exe, scene, options, Some(visibility), Some(oracle), time_for, &out)?;
                 if let Some(prev) = runs[m].as_ref().and_then(|r| r.stats["peak_rss_bytes"].as_u64()) {
                     let peak = s["peak_rss_bytes"].as_u64().map_or(prev, |p| p.min(prev));
                     s["peak_rss_bytes"] = peak.into();
@@ -401,7 +408,7 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
             if !args.json {
                 let name = std::path::Path::new(scene).file_name().and_then(|n| n.to_str()).unwrap_or(scene);
                 println!(
-                    "{:<18} {:<10} {:>9} {:>9} {:>11} {:>9.3} {:>9.3} {:>9.1} {:>10.2e} {:>8.2} {:>8.2} {:>6}",
+                    "{:<18} {:<12} {:>9} {:>9} {:>11} {:>9.3} {:>9.3} {:>9.1} {:>10.2e} {:>8.2} {:>8.2} {:>6}",
                     name,
                     method,
                     s["links"].as_u64().unwrap_or(0),
