@@ -1,0 +1,35 @@
+//! `radiosity bench shafts` end to end on the Cornell box: every method's row, the repeated solves
+//! of `solve --time-for`, and the shafts' results within the ray-sampling noise that the reseeded
+//! plain-rays row measures.
+
+use std::process::Command;
+
+#[test]
+fn bench_shafts_rows_repeats_and_noise() {
+    let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["bench", "shafts", "cornell", "--repeats", "2", "--time-for", "0.05", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    let methods: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(methods, ["rays", "aabb", "obb", "aabb/shaft", "obb/shaft", "rays/seed+1"]);
+    let row = |m: &str| rows.iter().find(|r| r["method"] == m).unwrap();
+    for r in &rows {
+        // Round 1 solves once; round 2 solves at least twice within its process.
+        assert!(r["timed_runs"].as_u64().unwrap() >= 3, "{r}");
+        for key in ["links", "elements", "rays", "time_s", "peak_rss_bytes", "max_rel_diff_to_rays"] {
+            assert!(!r[key].is_null(), "{key} missing: {r}");
+        }
+    }
+    let diff = |m: &str| row(m)["max_rel_diff_to_rays"].as_f64().unwrap();
+    let noise = diff("rays/seed+1");
+    assert!(noise > 0.0, "another seed changes the plain-rays solution");
+    for m in ["aabb", "obb", "aabb/shaft", "obb/shaft"] {
+        assert!(diff(m) <= noise, "{m}: {} against ray noise {noise}", diff(m));
+    }
+    // Under BF the shafts cull rays without changing the links; the shaft oracle links less.
+    assert_eq!(row("obb")["links"], row("rays")["links"]);
+    assert!(row("obb")["rays"].as_u64() < row("rays")["rays"].as_u64());
+    assert!(row("obb/shaft")["links"].as_u64() < row("rays")["links"].as_u64());
+}
