@@ -85,7 +85,12 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         "--level-cache-mb must be between 0 and 1e6, got {}",
         args.level_cache_mb
     );
-    if args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"))) {
+    let instanced = args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")));
+    anyhow::ensure!(
+        args.time_for == 0.0 || !(instanced || args.instances == Instances::Auto),
+        "--time-for applies to plain scenes, not to instanced ones"
+    );
+    if instanced {
         let path = args.scene.as_ref().expect("checked above");
         let scene = radiosity::instancing::load(path)?;
         return solve_instanced(args, &scene, None);
