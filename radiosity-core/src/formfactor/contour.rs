@@ -95,12 +95,25 @@ fn parallel_pair(a: DVec3, ea: DVec3, b: DVec3, eb: DVec3) -> f64 {
     -(psi(a1 - b1) - psi(a1 - b0) - psi(a0 - b1) + psi(a0 - b0))
 }
 
-/// `∫₀¹ ln |p − b − t e| dt`, exactly.
+/// Edges shorter than this fraction of their distance from the point are integrated by
+/// Gauss–Legendre in [`inner`]: its closed form divides by the squared edge length and cancels
+/// catastrophically for short edges (an edge 1e-9 long, 0.9 away, left 1e-8 of noise, which the
+/// outer integral's adaptive bisection then chased to its depth limit: office2's refinement
+/// spent 95% of its time there). Below this ratio the integrand `ln|w + t e|` has its nearest
+/// complex singularity at least 1/ratio away from `[0, 1]`, and 8 Gauss–Legendre points are exact
+/// to rounding (error of order ratio^16).
+pub const SHORT_EDGE_RATIO: f64 = 0.25;
+
+/// `∫₀¹ ln |p − b − t e| dt`, exactly (in closed form, or by quadrature for an edge short
+/// compared with its distance, see [`SHORT_EDGE_RATIO`]).
 fn inner(p: DVec3, b: DVec3, e: DVec3) -> f64 {
     let w = b - p;
     let qa = e.length_squared();
-    let qb = 2.0 * e.dot(w);
     let qc = w.length_squared();
+    if qa < SHORT_EDGE_RATIO * SHORT_EDGE_RATIO * qc {
+        return GL8.iter().map(|&(x, wt)| wt * 0.5 * (w + x * e).length_squared().ln()).sum();
+    }
+    let qb = 2.0 * e.dot(w);
     let disc = 4.0 * qa * qc - qb * qb;
     let scale = qa * qc;
     if disc <= 1e-14 * scale.max(f64::MIN_POSITIVE) {
@@ -282,5 +295,51 @@ mod tests {
         p2_rep.insert(1, v(1e-15, 3e-15, 0.));
         let (f, g) = (polygon_polygon(&p1, &p2), polygon_polygon(&p1, &p2_rep));
         assert!(f > 0.0 && (f - g).abs() < 1e-12, "{f} vs {g}");
+    }
+
+    /// `∫₀¹ ln|p − b − t e| dt` by 64 Gauss–Legendre panels: exact to rounding for a smooth integrand.
+    fn inner_by_panels(p: DVec3, b: DVec3, e: DVec3) -> f64 {
+        let n = 64;
+        (0..n)
+            .flat_map(|k| GL8.iter().map(move |&(x, w)| ((k as f64 + x) / n as f64, w / n as f64)))
+            .map(|(t, w)| w * (p - b - t * e).length().ln())
+            .sum()
+    }
+
+    #[test]
+    fn short_edges_integrate_without_cancellation() {
+        // An edge 2.3e-9 long, 0.9 from the point (the office2 pair that stalled the outer
+        // quadrature): the closed form would cancel to ~1e-8; the quadrature branch is exact.
+        let (a, b) = (v(0.0, 0.0, 0.0), v(0.341_682, 0.350_363, 0.872_066));
+        let e = v(-5.05e-10, 1.38e-10, -2.26e-9);
+        let exact = inner_by_panels(a, b, e);
+        assert!((inner(a, b, e) - exact).abs() < 1e-14, "{} vs {exact}", inner(a, b, e));
+        // Both branches agree on either side of the switch.
+        let w = b - a;
+        for ratio in [0.9 * SHORT_EDGE_RATIO, 1.1 * SHORT_EDGE_RATIO, 0.5, 2.0] {
+            let e = v(0.3, -0.8, 0.2).normalize() * (ratio * w.length());
+            let exact = inner_by_panels(a, b, e);
+            assert!((inner(a, b, e) - exact).abs() < 1e-12, "ratio {ratio}: {} vs {exact}", inner(a, b, e));
+        }
+    }
+
+    #[test]
+    fn the_outer_quadrature_of_a_short_edge_converges_in_few_panels() {
+        use std::cell::Cell;
+        // Edge b is 2.3e-9 long; edge a is an ordinary polygon edge. Before the quadrature branch,
+        // the integrand's noise sent adaptive bisection to its depth limit (894,905 splits).
+        let (a, ea) = (v(0.0, 0.0, 0.0), v(0.146_836, 0.403_435, 0.0));
+        let (b, eb) = (v(0.341_682, 0.350_363, 0.872_066), v(-5.05e-10, 1.38e-10, -2.26e-9));
+        let calls = Cell::new(0u32);
+        let value = adaptive(&|s: f64| {
+            calls.set(calls.get() + 1);
+            inner(a + s * ea, b, eb)
+        });
+        assert!(calls.get() < 1_000, "{} integrand calls", calls.get());
+        let exact: f64 = (0..64)
+            .flat_map(|k| GL8.iter().map(move |&(x, w)| ((k as f64 + x) / 64.0, w / 64.0)))
+            .map(|(s, w)| w * inner_by_panels(a + s * ea, b, eb))
+            .sum();
+        assert!((value - exact).abs() < 1e-13, "{value} vs {exact}");
     }
 }
