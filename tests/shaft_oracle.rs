@@ -100,3 +100,63 @@ fn the_explained_track_shows_the_shaft() {
     assert!(shaft_step.shaft.is_some(), "{text}");
     assert!(text.contains("shaft=partial ("), "{text}");
 }
+
+/// A graph file may use the shaft tools: the file below is the shaft oracle's graph, and the
+/// runtime gives it shafts and the release's links.
+#[test]
+fn a_graph_file_with_shaft_tools_gets_shafts() {
+    use radiosity::oracle::runtime::{DagOracle, parse_graph};
+    use radiosity::refine::Oracle;
+    const SHAFT_TOML: &str = r#"# The shaft oracle as a graph file.
+name = "shaft-file"
+doc = "Shaft oracle from a graph file."
+start = "facing"
+
+[[param]]
+name = "eps"
+default = 0.01
+min = 0.0
+max = 1.0
+
+[[node]]
+name = "facing"
+tool = "Facing"
+arms = [{ on = "No", to = "stop" }, { on = "Yes", to = "bound" }]
+
+[[node]]
+name = "bound"
+tool = "BfAbove"
+args = ["eps"]
+arms = [{ on = "No", to = "link" }, { on = "Yes", to = "shaft" }]
+
+[[node]]
+name = "shaft"
+tool = "ShaftClassify"
+arms = [{ on = "Invisible", to = "stop" }, { on = "Visible", to = "error" }, { on = "Partial", to = "error" }]
+
+[[node]]
+name = "error"
+tool = "ShaftFfError"
+args = ["eps"]
+arms = [{ on = "Below", to = "link" }, { on = "Above", to = "size" }]
+
+[[node]]
+name = "size"
+tool = "CanSubdivide"
+args = [0.0]
+arms = [{ on = "Neither", to = "link" }, { on = "Emitter", to = "subdivide_emitter" }, { on = "Receiver", to = "subdivide_receiver" }, { on = "Both", to = "first" }]
+
+[[node]]
+name = "first"
+tool = "SplitFirst"
+arms = [{ on = "Emitter", to = "subdivide_emitter" }, { on = "Receiver", to = "subdivide_receiver" }]
+"#;
+    let graph = parse_graph(SHAFT_TOML, std::path::Path::new("shaft.toml")).expect("valid graph file");
+    let dag = DagOracle::new(graph, &[]).expect("built-in tools only");
+    assert!(dag.needs().shafts);
+    let scene = stairs_with_beam();
+    let release = ShaftOracle::new(ShaftOracleParams::default());
+    let (a, b) = (pipeline::run(&scene, &release, &Config::default(), &|_| {}), pipeline::run(&scene, &dag, &Config::default(), &|_| {}));
+    assert!(b.shaft_classified.iter().sum::<u64>() > 0, "the file's shaft tools classified shafts");
+    assert_eq!(a.links.len(), b.links.len());
+}
