@@ -101,34 +101,15 @@ fn the_explained_track_shows_the_shaft() {
     assert!(text.contains("shaft=partial ("), "{text}");
 }
 
-/// A graph file may use the shaft tools: the file below is the shaft oracle's graph, and the
-/// runtime gives it shafts and the release's links.
+/// A graph file may use the shaft tools. The file is BF's graph file with the shaft oracle's two
+/// shaft nodes between BF's energy test and the split (the shaft oracle's graph), and the runtime
+/// gives it shafts and the release's links.
 #[test]
 fn a_graph_file_with_shaft_tools_gets_shafts() {
+    use radiosity::oracle::bf::BF_TOML;
     use radiosity::oracle::runtime::{DagOracle, parse_graph};
     use radiosity::refine::Oracle;
-    const SHAFT_TOML: &str = r#"# The shaft oracle as a graph file.
-name = "shaft-file"
-doc = "Shaft oracle from a graph file."
-start = "facing"
-
-[[param]]
-name = "eps"
-default = 0.01
-min = 0.0
-max = 1.0
-
-[[node]]
-name = "facing"
-tool = "Facing"
-arms = [{ on = "No", to = "stop" }, { on = "Yes", to = "bound" }]
-
-[[node]]
-name = "bound"
-tool = "BfAbove"
-args = ["eps"]
-arms = [{ on = "No", to = "link" }, { on = "Yes", to = "shaft" }]
-
+    const SHAFT_NODES: &str = r#"
 [[node]]
 name = "shaft"
 tool = "ShaftClassify"
@@ -139,19 +120,12 @@ name = "error"
 tool = "ShaftFfError"
 args = ["eps"]
 arms = [{ on = "Below", to = "link" }, { on = "Above", to = "size" }]
-
-[[node]]
-name = "size"
-tool = "CanSubdivide"
-args = [0.0]
-arms = [{ on = "Neither", to = "link" }, { on = "Emitter", to = "subdivide_emitter" }, { on = "Receiver", to = "subdivide_receiver" }, { on = "Both", to = "first" }]
-
-[[node]]
-name = "first"
-tool = "SplitFirst"
-arms = [{ on = "Emitter", to = "subdivide_emitter" }, { on = "Receiver", to = "subdivide_receiver" }]
 "#;
-    let graph = parse_graph(SHAFT_TOML, std::path::Path::new("shaft.toml")).expect("valid graph file");
+    let energy_to_size = r#"arms = [{ on = "No", to = "link" }, { on = "Yes", to = "size" }]"#;
+    assert!(BF_TOML.contains(energy_to_size), "BF's energy node splits when above eps");
+    let energy_to_shaft = energy_to_size.replace(r#"to = "size" }]"#, r#"to = "shaft" }]"#);
+    let shaft_toml = BF_TOML.replacen(energy_to_size, &energy_to_shaft, 1) + SHAFT_NODES;
+    let graph = parse_graph(&shaft_toml, std::path::Path::new("shaft.toml")).expect("valid graph file");
     let dag = DagOracle::new(graph, &[]).expect("built-in tools only");
     assert!(dag.needs().shafts);
     let scene = stairs_with_beam();

@@ -125,11 +125,10 @@ impl DynTool {
         let names: &'static [&'static str] = match name {
             "BfAbove" | "Facing" | "ClusterTooNear" | "PlanesIntersect" | "ProjectedAreaBelow" => YesNo::NAMES,
             "IrradianceChange" => Irradiance::NAMES,
-            "FfGradient" => FfSpread::NAMES,
+            "FfGradient" | "ShaftFfError" => FfSpread::NAMES,
             "RayVisibility" => VisibilityClass::NAMES,
             "ReferenceVisibility" => ReferenceClass::NAMES,
             "ShaftClassify" => ShaftAnswer::NAMES,
-            "ShaftFfError" => FfError::NAMES,
             "CanSubdivide" => Subdividable::NAMES,
             "Larger" | "SplitFirst" => Side::NAMES,
             "NormalCone" => Cone::NAMES,

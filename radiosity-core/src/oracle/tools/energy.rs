@@ -44,9 +44,10 @@ impl Tool for IrradianceChange {
 }
 
 crate::answer_enum! {
-    /// Answer of [`FfGradient`].
+    /// Answer of [`FfGradient`] and [`super::ShaftFfError`].
     pub enum FfSpread {
-        /// The point form factor varies by more than the threshold over the receiver.
+        /// The point form factor (or the transfer `B_S · F`) varies by more than the threshold over
+        /// the receiver.
         Above,
         /// It does not.
         Below,

@@ -13,5 +13,5 @@ pub use geometry::{
     CanSubdivide, ClusterTooNear, Cone, Facing, Larger, NormalCone, PlanesIntersect, ProjectedAreaBelow, Side, SplitFirst, Subdividable,
     YesNo,
 };
-pub use shaft::{FfError, ShaftAnswer, ShaftClassify, ShaftFfError};
+pub use shaft::{ShaftAnswer, ShaftClassify, ShaftFfError};
 pub use visibility::{PROBABLE_BELOW_RAYS, REFERENCE_RAYS, RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};

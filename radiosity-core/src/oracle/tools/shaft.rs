@@ -2,6 +2,7 @@
 //! error bounded with it. Both need shaft culling ([`crate::refine::Needs::SHAFTS`]), which
 //! [`crate::pipeline::run`] turns on for any oracle that asks them.
 
+use super::FfSpread;
 use crate::oracle::Tool;
 use crate::refine::LinkCtx;
 use crate::visibility::shaft::ShaftClass;
@@ -35,30 +36,21 @@ impl Tool for ShaftClassify {
     }
 }
 
-crate::answer_enum! {
-    /// Answer of [`ShaftFfError`].
-    pub enum FfError {
-        /// `B_S · (F_max − F_min)` exceeds the threshold.
-        Above,
-        /// It does not.
-        Below,
-    }
-}
-
 /// Is `B_S · (F_max − F_min) > eps · B_ref`? `F_min` is the smallest point form factor over the
-/// receiver when the shaft is empty, and 0 when some candidate may occlude.
+/// receiver when the shaft is empty, and 0 when some candidate may occlude (a spread over the
+/// receiver, so the answer is [`FfSpread`], as [`super::FfGradient`]'s).
 #[derive(Clone, Copy, Debug)]
 pub struct ShaftFfError(pub f64);
 
 impl Tool for ShaftFfError {
-    type Answer = FfError;
+    type Answer = FfSpread;
     const NEEDS: crate::refine::Needs = crate::refine::Needs::SHAFTS;
-    fn ask(&self, ctx: &mut LinkCtx<'_>) -> FfError {
+    fn ask(&self, ctx: &mut LinkCtx<'_>) -> FfSpread {
         let f_max = ctx.form_factor_max();
         let f_min = match ctx.shaft_verdict() {
             Some(ShaftClass::Visible) => ctx.form_factor_range().0.min(f_max),
             _ => 0.0,
         };
-        if ctx.emitter_radiosity() * (f_max - f_min) > self.0 * ctx.services.b_ref { FfError::Above } else { FfError::Below }
+        if ctx.emitter_radiosity() * (f_max - f_min) > self.0 * ctx.services.b_ref { FfSpread::Above } else { FfSpread::Below }
     }
 }
