@@ -68,6 +68,32 @@ pub enum VisibilityMethod {
     Shafts(crate::visibility::shaft::BoundingVolume),
 }
 
+impl VisibilityMethod {
+    /// Every method.
+    pub const ALL: [VisibilityMethod; 4] = {
+        use crate::visibility::shaft::BoundingVolume::{Aabb, Hull, Obb};
+        [VisibilityMethod::Rays, VisibilityMethod::Shafts(Aabb), VisibilityMethod::Shafts(Obb), VisibilityMethod::Shafts(Hull)]
+    };
+
+    /// The method's name, as the command line and `stats.json` spell it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        use crate::visibility::shaft::BoundingVolume::{Aabb, Hull, Obb};
+        match self {
+            VisibilityMethod::Rays => "rays",
+            VisibilityMethod::Shafts(Aabb) => "aabb",
+            VisibilityMethod::Shafts(Obb) => "obb",
+            VisibilityMethod::Shafts(Hull) => "hull",
+        }
+    }
+
+    /// The method called `name` (see [`VisibilityMethod::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<VisibilityMethod> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
 /// Seconds spent per phase.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct Timings {
@@ -339,6 +365,16 @@ fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn visibility_methods_are_found_by_their_names() {
+        let names: Vec<&str> = VisibilityMethod::ALL.iter().map(|m| m.name()).collect();
+        assert_eq!(names, ["rays", "aabb", "obb", "hull"]);
+        for m in VisibilityMethod::ALL {
+            assert_eq!(VisibilityMethod::from_name(m.name()), Some(m));
+        }
+        assert_eq!(VisibilityMethod::from_name("bvh"), None);
+    }
 
     /// Every cluster's first guess is the area-weighted mean of its polygons' (a cluster's children
     /// are built after it, so a pass in id order would average children not yet set).

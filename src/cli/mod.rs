@@ -122,14 +122,9 @@ impl CommonOptions {
         config.visibility.seed = self.seed;
         config.build.min_area_rel = self.min_area;
         config.use_visibility = !self.no_visibility;
+        // clap accepts only the names `VisibilityMethod::name` gives.
         use radiosity::pipeline::VisibilityMethod;
-        use radiosity::visibility::shaft::BoundingVolume;
-        config.visibility_method = match self.visibility.as_str() {
-            "aabb" => VisibilityMethod::Shafts(BoundingVolume::Aabb),
-            "obb" => VisibilityMethod::Shafts(BoundingVolume::Obb),
-            "hull" => VisibilityMethod::Shafts(BoundingVolume::Hull),
-            _ => VisibilityMethod::Rays,
-        };
+        config.visibility_method = VisibilityMethod::from_name(&self.visibility).unwrap_or(VisibilityMethod::Rays);
         config
     }
 }

@@ -138,13 +138,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         "rays": args.options.common.rays,
         "seed": args.options.common.seed,
         "min_area": args.options.common.min_area,
-        "visibility": match config.visibility_method {
-            _ if args.options.common.no_visibility => "none",
-            pipeline::VisibilityMethod::Rays => "rays",
-            pipeline::VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Aabb) => "aabb",
-            pipeline::VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Obb) => "obb",
-            pipeline::VisibilityMethod::Shafts(radiosity::visibility::shaft::BoundingVolume::Hull) => "hull",
-        },
+        "visibility": if args.options.common.no_visibility { "none" } else { config.visibility_method.name() },
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     let out_config =

@@ -141,9 +141,8 @@ pub fn refine(
         }
         drop(pending);
         let mut next = Vec::new();
-        for (source, receiver, d, cands, culled_diag) in splits {
-            let c = Candidate { source, receiver, existing: None, cands: None, culled_diag };
-            split(h, radiosity, &c, d, cands, culled_diag, &mut next);
+        for s in splits {
+            split(h, radiosity, s, &mut next);
         }
         pending = next;
         progress(out.len() as u64, pending.len() as u64);
@@ -202,15 +201,10 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
     }
 }
 
-fn split(
-    h: &mut Hierarchy,
-    radiosity: &mut Vec<[f64; 3]>,
-    c: &Candidate,
-    d: Decision,
-    cands: Option<Arc<[u32]>>,
-    culled_diag: f64,
-    next: &mut Vec<Candidate>,
-) {
+/// Subdivides as decided (children inherit their parent's radiosity) and queues the children's
+/// links, which inherit the candidates and the diagonal they were culled for.
+fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, pending: PendingSplit, next: &mut Vec<Candidate>) {
+    let (source, receiver, d, cands, culled_diag) = pending;
     let mut children_of = |h: &mut Hierarchy, id: ElementId| -> Vec<ElementId> {
         if h.get(id).n_children == 0 {
             h.subdivide(id);
@@ -224,18 +218,18 @@ fn split(
     };
     match d {
         Decision::SubdivideEmitter => {
-            for s in children_of(h, c.source) {
-                next.push(Candidate { source: s, receiver: c.receiver, existing: None, cands: cands.clone(), culled_diag });
+            for s in children_of(h, source) {
+                next.push(Candidate { source: s, receiver, existing: None, cands: cands.clone(), culled_diag });
             }
         }
         Decision::SubdivideReceiver => {
-            for r in children_of(h, c.receiver) {
-                next.push(Candidate { source: c.source, receiver: r, existing: None, cands: cands.clone(), culled_diag });
+            for r in children_of(h, receiver) {
+                next.push(Candidate { source, receiver: r, existing: None, cands: cands.clone(), culled_diag });
             }
         }
         Decision::SubdivideBoth => {
-            let ss = children_of(h, c.source);
-            let rs = if c.receiver == c.source { ss.clone() } else { children_of(h, c.receiver) };
+            let ss = children_of(h, source);
+            let rs = if receiver == source { ss.clone() } else { children_of(h, receiver) };
             for &r in &rs {
                 for &s in &ss {
                     next.push(Candidate { source: s, receiver: r, existing: None, cands: cands.clone(), culled_diag });
