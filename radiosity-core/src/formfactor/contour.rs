@@ -297,13 +297,15 @@ mod tests {
         assert!(f > 0.0 && (f - g).abs() < 1e-12, "{f} vs {g}");
     }
 
-    /// `∫₀¹ ln|p − b − t e| dt` by 64 Gauss–Legendre panels: exact to rounding for a smooth integrand.
-    fn inner_by_panels(p: DVec3, b: DVec3, e: DVec3) -> f64 {
+    /// `∫₀¹ f` by 64 Gauss–Legendre panels: exact to rounding for a smooth integrand.
+    fn by_panels(f: impl Fn(f64) -> f64) -> f64 {
         let n = 64;
-        (0..n)
-            .flat_map(|k| GL8.iter().map(move |&(x, w)| ((k as f64 + x) / n as f64, w / n as f64)))
-            .map(|(t, w)| w * (p - b - t * e).length().ln())
-            .sum()
+        (0..n).flat_map(|k| GL8.iter().map(move |&(x, w)| ((k as f64 + x) / n as f64, w / n as f64))).map(|(t, w)| w * f(t)).sum()
+    }
+
+    /// `∫₀¹ ln|p − b − t e| dt` by [`by_panels`].
+    fn inner_by_panels(p: DVec3, b: DVec3, e: DVec3) -> f64 {
+        by_panels(|t| (p - b - t * e).length().ln())
     }
 
     #[test]
@@ -336,10 +338,7 @@ mod tests {
             inner(a + s * ea, b, eb)
         });
         assert!(calls.get() < 1_000, "{} integrand calls", calls.get());
-        let exact: f64 = (0..64)
-            .flat_map(|k| GL8.iter().map(move |&(x, w)| ((k as f64 + x) / 64.0, w / 64.0)))
-            .map(|(s, w)| w * inner_by_panels(a + s * ea, b, eb))
-            .sum();
+        let exact = by_panels(|s| inner_by_panels(a + s * ea, b, eb));
         assert!((value - exact).abs() < 1e-13, "{value} vs {exact}");
     }
 }
