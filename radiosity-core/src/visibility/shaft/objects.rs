@@ -78,7 +78,7 @@ pub struct ShaftObject {
 
 /// What an object can block a whole shaft with: its closed convex solid, or else its merged
 /// plates. Built on the object's first occlusion test ([`ShaftObjects::solid_of`],
-/// [`ShaftObjects::merged_of`]): most objects never get one (the hospital: 14 occlusion tests for
+/// [`ShaftObjects::merged_of`]): most objects never get one (the hospital: 14 split-link verdicts for
 /// 1,080 objects), and building them all took 40% of building the objects.
 #[derive(Clone, Debug, Default)]
 struct Occluder {
