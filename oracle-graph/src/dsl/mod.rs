@@ -1,5 +1,5 @@
 //! The `oracle!` macro as plain functions on token streams (the proc-macro crate only forwards
-//! here, so tests can expand and snapshot): [`parse`] → [`check`] → [`expand`].
+//! here, so tests can expand and snapshot): [`parse`] → [`check`] → [`expand()`].
 
 pub mod check;
 pub mod expand;
@@ -36,7 +36,7 @@ pub fn expand(input: TokenStream) -> TokenStream {
     out
 }
 
-/// [`expand`] on source text (for tests and tools); text that does not lex becomes a
+/// [`expand()`] on source text (for tests and tools); text that does not lex becomes a
 /// `compile_error!`.
 #[must_use]
 pub fn expand_str(src: &str) -> TokenStream {

@@ -1,5 +1,5 @@
 //! Automatic instancing of a plain [`Scene`]: objects (the polygons of one OBJ object / group,
-//! [`Polygon::group`]) that are identical up to a rigid transform become instances of one
+//! [`Polygon::group`](crate::scene::Polygon::group)) that are identical up to a rigid transform become instances of one
 //! prototype.
 //!
 //! # Method
@@ -101,7 +101,7 @@ pub struct AutoResult {
     pub scene: InstancedScene,
     /// Counts.
     pub report: AutoReport,
-    /// Input polygon index of every polygon of [`crate::instancing::flatten`]'s output without
+    /// Input polygon index of every polygon of [`crate::instancing::flatten()`]'s output without
     /// two-sided pairs (`FlattenOptions { two_sided_pairs: false }`), in flattening order.
     pub flat_to_input: Vec<u32>,
 }

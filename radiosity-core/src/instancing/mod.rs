@@ -2,7 +2,7 @@
 //!
 //! Data flow, one line per step:
 //! - [`load`] (TOML scene file, prototypes from OBJ or generated) → [`InstancedScene`]
-//! - [`flatten`] → a plain [`crate::scene::Scene`] for the reference ("full") solve
+//! - [`flatten()`] → a plain [`crate::scene::Scene`] for the reference ("full") solve
 //! - [`properties`]: per prototype τ(ω), a(ω) = (1 − τ(ω))·A_box(ω) and the escape albedo, cached on
 //!   disk by content hash
 //! - [`solve_instanced`]: closed instances as proxies, then depth-first opening, streaming polygons

@@ -217,7 +217,7 @@ pub struct Leaf {
 /// Which flattened polygon a streamed polygon is.
 #[derive(Clone, Copy, Debug)]
 pub struct PolygonInfo {
-    /// Index in [`super::flatten`] order with two-sided pairs.
+    /// Index in [`super::flatten()`] order with two-sided pairs.
     pub flat_index: u64,
     /// Scene material.
     pub material: u32,
@@ -1115,7 +1115,7 @@ fn brightness_class(bound: [f64; 3]) -> (i32, f64) {
 /// and the brightness class of its light.
 type LevelKey = (PrototypeId, Vec<bool>, i32);
 
-/// Relative tolerance of [`similarity`]: how far from orthogonal the rotation part may be.
+/// Relative tolerance of `similarity`: how far from orthogonal the rotation part may be.
 pub const SIMILARITY_TOLERANCE: f64 = 1e-6;
 
 /// The motion from one instance's frame to another's, when it is a similarity.

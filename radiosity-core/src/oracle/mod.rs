@@ -1,7 +1,7 @@
 //! Refinement oracles as decision graphs (step 3, `refine`, seen from the oracle's side): the
 //! [`Tool`] trait and the built-in [`tools`], parameters, instrumentation ([`Probe`]), the DAG
 //! runtime ([`runtime`]), the BF oracle in its three releases ([`bf`]), and the benchmark that
-//! compares them ([`bench`]) on procedurally generated scenes ([`scenes`]).
+//! compares them ([`mod@bench`]) on procedurally generated scenes ([`scenes`]).
 //!
 //! The per-link data manager is [`crate::refine::LinkData`]: each slot is filled by the first tool
 //! that asks for it, at the precision it asks (form factor quality, ray count), and reused by

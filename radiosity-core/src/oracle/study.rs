@@ -1,6 +1,6 @@
 //! The visibility study: for the links of a BF solution whose areas projected along the link are
 //! below a threshold, classify visibility with 4, 16 and 64 rays beside the reference classifier
-//! ([`ReferenceVisibility`](super::tools::ReferenceVisibility)) and count disagreements.
+//! ([`super::tools::ReferenceVisibility`]) and count disagreements.
 
 use super::Tool;
 use super::tools::{RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};

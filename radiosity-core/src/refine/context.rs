@@ -231,7 +231,7 @@ impl<'a> LinkCtx<'a> {
     }
 
     /// Whether a cluster is involved and the two elements are too near for the isotropic
-    /// approximation: centre distance below [`CLUSTER_NEAR_FACTOR`] times the sum of the radii.
+    /// approximation: centre distance below `CLUSTER_NEAR_FACTOR` times the sum of the radii.
     #[must_use]
     pub fn clusters_too_near(&self) -> bool {
         let (s, r) = (self.emitter_element(), self.receiver_element());

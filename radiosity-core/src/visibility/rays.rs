@@ -193,7 +193,7 @@ impl RayCaster {
     }
 
     /// Closest hit along a ray in scene coordinates: `(distance, input polygon)`. Direction
-    /// components that are exactly zero are nudged (see [`ray_direction`]).
+    /// components that are exactly zero are nudged (see `ray_direction`).
     #[must_use]
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3) -> Option<(f64, u32)> {
         if self.triangles.is_empty() {
@@ -210,7 +210,7 @@ impl RayCaster {
 
     /// True when the ray from `origin` along `dir` (scene coordinates) meets no triangle: an
     /// occlusion query, cheaper than [`RayCaster::closest_hit`]. Direction components that are
-    /// exactly zero are nudged (see [`ray_direction`]).
+    /// exactly zero are nudged (see `ray_direction`).
     #[must_use]
     pub fn ray_clear(&self, origin: DVec3, dir: DVec3) -> bool {
         self.rays_cast.add(1);
