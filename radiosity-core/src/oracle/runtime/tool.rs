@@ -29,6 +29,33 @@ pub enum DynTool {
     Mark(Mark),
 }
 
+/// `$e` with `$t` bound to the tool inside whichever variant `$tool` is: the one list of variants
+/// that the generic dispatches ([`DynTool::ask`], [`DynTool::needs`]) share.
+macro_rules! on_tool {
+    ($tool:expr, $t:ident => $e:expr) => {
+        match $tool {
+            DynTool::BfAbove($t) => $e,
+            DynTool::IrradianceChange($t) => $e,
+            DynTool::FfGradient($t) => $e,
+            DynTool::RayVisibility($t) => $e,
+            DynTool::ReferenceVisibility($t) => $e,
+            DynTool::ShaftClassify($t) => $e,
+            DynTool::ShaftFfError($t) => $e,
+            DynTool::Facing($t) => $e,
+            DynTool::ClusterTooNear($t) => $e,
+            DynTool::CanSubdivide($t) => $e,
+            DynTool::Larger($t) => $e,
+            DynTool::SplitFirst($t) => $e,
+            DynTool::PlanesIntersect($t) => $e,
+            DynTool::ProjectedAreaBelow($t) => $e,
+            DynTool::NormalCone($t) => $e,
+            DynTool::PreciseVisibility($t) => $e,
+            DynTool::PreciseFormFactor($t) => $e,
+            DynTool::Mark($t) => $e,
+        }
+    };
+}
+
 fn needs<T: Tool>(_: &T) -> crate::refine::Needs {
     T::NEEDS
 }
@@ -72,51 +99,13 @@ impl DynTool {
     /// Asks the tool: the answer's index and the answer enum's variant names.
     #[inline]
     pub fn ask(&self, ctx: &mut LinkCtx<'_>) -> (usize, &'static [&'static str]) {
-        match self {
-            DynTool::BfAbove(t) => ask(t, ctx),
-            DynTool::IrradianceChange(t) => ask(t, ctx),
-            DynTool::FfGradient(t) => ask(t, ctx),
-            DynTool::RayVisibility(t) => ask(t, ctx),
-            DynTool::ReferenceVisibility(t) => ask(t, ctx),
-            DynTool::ShaftClassify(t) => ask(t, ctx),
-            DynTool::ShaftFfError(t) => ask(t, ctx),
-            DynTool::Facing(t) => ask(t, ctx),
-            DynTool::ClusterTooNear(t) => ask(t, ctx),
-            DynTool::CanSubdivide(t) => ask(t, ctx),
-            DynTool::Larger(t) => ask(t, ctx),
-            DynTool::SplitFirst(t) => ask(t, ctx),
-            DynTool::PlanesIntersect(t) => ask(t, ctx),
-            DynTool::ProjectedAreaBelow(t) => ask(t, ctx),
-            DynTool::NormalCone(t) => ask(t, ctx),
-            DynTool::PreciseVisibility(t) => ask(t, ctx),
-            DynTool::PreciseFormFactor(t) => ask(t, ctx),
-            DynTool::Mark(t) => ask(t, ctx),
-        }
+        on_tool!(self, t => ask(t, ctx))
     }
 
     /// The pipeline services the tool needs ([`Tool::NEEDS`]).
     #[must_use]
     pub fn needs(&self) -> crate::refine::Needs {
-        match self {
-            DynTool::BfAbove(t) => needs(t),
-            DynTool::IrradianceChange(t) => needs(t),
-            DynTool::FfGradient(t) => needs(t),
-            DynTool::RayVisibility(t) => needs(t),
-            DynTool::ReferenceVisibility(t) => needs(t),
-            DynTool::ShaftClassify(t) => needs(t),
-            DynTool::ShaftFfError(t) => needs(t),
-            DynTool::Facing(t) => needs(t),
-            DynTool::ClusterTooNear(t) => needs(t),
-            DynTool::CanSubdivide(t) => needs(t),
-            DynTool::Larger(t) => needs(t),
-            DynTool::SplitFirst(t) => needs(t),
-            DynTool::PlanesIntersect(t) => needs(t),
-            DynTool::ProjectedAreaBelow(t) => needs(t),
-            DynTool::NormalCone(t) => needs(t),
-            DynTool::PreciseVisibility(t) => needs(t),
-            DynTool::PreciseFormFactor(t) => needs(t),
-            DynTool::Mark(t) => needs(t),
-        }
+        on_tool!(self, t => needs(t))
     }
 
     /// Variant names of the tool `name`'s answer enum (for checking the catalogue).
