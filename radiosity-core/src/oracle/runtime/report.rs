@@ -1,7 +1,7 @@
 //! Text and DOT renderings of what a [`crate::oracle::Recorder`] gathered.
 
-use crate::oracle::{NodeStats, TraceStep};
-use crate::visibility::shaft::ShaftClass;
+use crate::oracle::tools::ShaftAnswer;
+use crate::oracle::{Answer, NodeStats, TraceStep};
 use oracle_graph::Graph;
 use std::fmt::Write;
 
@@ -32,11 +32,7 @@ pub fn format_trace(graph: &Graph, trace: &[TraceStep]) -> String {
             values.push(format!("mark={m}"));
         }
         if let Some((class, candidates)) = step.shaft {
-            let class = match class {
-                ShaftClass::Invisible => "invisible",
-                ShaftClass::Visible => "visible",
-                ShaftClass::Partial { .. } => "partial",
-            };
+            let class = ShaftAnswer::NAMES[ShaftAnswer::from(class).index()].to_lowercase();
             values.push(format!("shaft={class} ({candidates} candidates)"));
         }
         let next = node.arms.iter().find(|a| a.answers.iter().any(|x| x == step.answer)).map_or("?", |a| a.target.word());

@@ -19,6 +19,16 @@ crate::answer_enum! {
     }
 }
 
+impl From<ShaftClass> for ShaftAnswer {
+    fn from(class: ShaftClass) -> ShaftAnswer {
+        match class {
+            ShaftClass::Invisible => ShaftAnswer::Invisible,
+            ShaftClass::Visible => ShaftAnswer::Visible,
+            ShaftClass::Partial { .. } => ShaftAnswer::Partial,
+        }
+    }
+}
+
 /// Classifies the link by its shaft (memoised in the link context, candidates inherited from the
 /// parent link). Partial when shaft culling is off.
 #[derive(Clone, Copy, Debug)]
@@ -28,11 +38,7 @@ impl Tool for ShaftClassify {
     type Answer = ShaftAnswer;
     const NEEDS: crate::refine::Needs = crate::refine::Needs::SHAFTS;
     fn ask(&self, ctx: &mut LinkCtx<'_>) -> ShaftAnswer {
-        match ctx.shaft_verdict() {
-            Some(ShaftClass::Invisible) => ShaftAnswer::Invisible,
-            Some(ShaftClass::Visible) => ShaftAnswer::Visible,
-            Some(ShaftClass::Partial { .. }) | None => ShaftAnswer::Partial,
-        }
+        ctx.shaft_verdict().map_or(ShaftAnswer::Partial, ShaftAnswer::from)
     }
 }
 

@@ -80,7 +80,7 @@ pub struct ShaftObject {
 /// plates. Built on the object's first occlusion test ([`ShaftObjects::solid_of`],
 /// [`ShaftObjects::merged_of`]): most objects never get one (the hospital: 14 split-link verdicts for
 /// 1,080 objects), and building them all took 40% of building the objects.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 struct Occluder {
     solid: Option<ConvexSolid>,
     merged: Vec<MergedPlate>,
