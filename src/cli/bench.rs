@@ -351,18 +351,18 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         if args.scenes.is_empty() { super::GENERATED_SCENES.iter().map(|s| s.to_string()).collect() } else { args.scenes.clone() };
     let exe = std::env::current_exe().context("locating this executable")?;
     let tmp = std::env::temp_dir().join(format!("radiosity-bench-shafts-{}", std::process::id()));
-    // (label, visibility, oracle): with `bf-hand` shafts only cull the rays (links as with plain
-    // rays); with the shaft oracle they also decide refinement, so tighter culling means fewer
-    // links. The plain-rays reference uses `bf-hand`: the shaft oracle needs shafts. The last
-    // method is plain rays again with the next seed: its difference to the first is the ray
-    // sampling noise, its speed-up the timing noise.
-    const METHODS: [(&str, &str, &str); 6] = [
-        ("rays", "rays", "bf-hand"),
-        ("aabb", "aabb", "bf-hand"),
-        ("obb", "obb", "bf-hand"),
-        ("aabb/shaft", "aabb", "shaft"),
-        ("obb/shaft", "obb", "shaft"),
-        ("rays/seed+1", "rays", "bf-hand"),
+    // (label, visibility, oracle, next seed): with `bf-hand` shafts only cull the rays (links as
+    // with plain rays); with the shaft oracle they also decide refinement, so tighter culling
+    // means fewer links. The plain-rays reference uses `bf-hand`: the shaft oracle needs shafts.
+    // The last method is plain rays again with the next seed: its difference to the first is the
+    // ray sampling noise, its speed-up the timing noise.
+    const METHODS: [(&str, &str, &str, bool); 6] = [
+        ("rays", "rays", "bf-hand", false),
+        ("aabb", "aabb", "bf-hand", false),
+        ("obb", "obb", "bf-hand", false),
+        ("aabb/shaft", "aabb", "shaft", false),
+        ("obb/shaft", "obb", "shaft", false),
+        ("rays/seed+1", "rays", "bf-hand", true),
     ];
     let mut reseeded = args.options.clone();
     reseeded.common.seed = reseeded.common.seed.wrapping_add(1);
@@ -379,9 +379,9 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
             // The first round solves once per process, for a peak memory that repeated solves
             // (which can only raise it) do not touch; the peak reported is the smallest.
             let time_for = if r == 0 && args.repeats > 1 { 0.0 } else { args.time_for };
-            for (m, &(_, visibility, oracle)) in METHODS.iter().enumerate() {
+            for (m, &(_, visibility, oracle, next_seed)) in METHODS.iter().enumerate() {
                 let out = tmp.join(format!("{i}-{m}"));
-                let options = if m + 1 == METHODS.len() { &reseeded } else { &args.options };
+                let options = if next_seed { &reseeded } else { &args.options };
                 let mut s = child_solve(&exe, scene, options, Some(visibility), Some(oracle), time_for, &out)?;
                 if let Some(prev) = runs[m].as_ref().and_then(|r| r.stats["peak_rss_bytes"].as_u64()) {
                     let peak = s["peak_rss_bytes"].as_u64().map_or(prev, |p| p.min(prev));
@@ -397,7 +397,7 @@ fn bench_shafts(args: &ShaftBenchArgs) -> anyhow::Result<()> {
         }
         let ShaftRun { time: rt, refine: rr, radiosity: rb, .. } = runs[0].clone().context("at least one run")?;
         let max = rb.iter().flatten().fold(0.0f64, |m, v| m.max(*v)).max(f64::MIN_POSITIVE);
-        for (&(method, visibility, oracle), run) in METHODS.iter().zip(runs) {
+        for (&(method, visibility, oracle, _), run) in METHODS.iter().zip(runs) {
             let ShaftRun { stats: s, time, refine, radiosity: b, runs: timed } = run.context("at least one run")?;
             let d = rb.iter().zip(&b).flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs())).fold(0.0f64, f64::max);
             let (diff, speedup, refine_speedup) = (d / max, rt / time, rr / refine);
