@@ -22,4 +22,5 @@ pub mod pipeline;
 pub mod refine;
 pub mod scene;
 pub mod solve;
+pub mod validation;
 pub mod visibility;
