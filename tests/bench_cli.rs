@@ -28,8 +28,11 @@ fn bench_shafts_rows_repeats_and_noise() {
     for m in ["aabb", "obb", "aabb/shaft", "obb/shaft"] {
         assert!(diff(m) <= noise, "{m}: {} against ray noise {noise}", diff(m));
     }
-    // Under BF the shafts cull rays without changing the links; the shaft oracle links less.
+    // Under BF the shafts cull rays without changing the links; the shaft oracle (BF with the
+    // shaft deciding visibility where it can) drops the links one occluder blocks and skips the
+    // visibility test of links nothing occludes: no more links, fewer rays.
     assert_eq!(row("obb")["links"], row("rays")["links"]);
     assert!(row("obb")["rays"].as_u64() < row("rays")["rays"].as_u64());
-    assert!(row("obb/shaft")["links"].as_u64() < row("rays")["links"].as_u64());
+    assert!(row("obb/shaft")["links"].as_u64() <= row("rays")["links"].as_u64());
+    assert!(row("obb/shaft")["rays"].as_u64() < row("rays")["rays"].as_u64());
 }

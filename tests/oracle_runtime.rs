@@ -7,7 +7,7 @@ use radiosity::oracle::graph::{BUILTIN_TOOLS, to_dot};
 use radiosity::oracle::runtime::{DagOracle, DynTool, GraphBuilder, format_stats, format_trace, load_graph, parse_graph};
 use radiosity::oracle::{NoProbe, Recorder};
 use radiosity::pipeline::{self, Config};
-use radiosity::refine::{Decision, LinkCtx, Oracle, Services};
+use radiosity::refine::{Decision, ElementData, LinkCtx, Oracle, Services};
 use radiosity::visibility::{RayCaster, VisibilityConfig};
 use std::path::Path;
 
@@ -127,14 +127,14 @@ fn statistics_and_trace_of_an_instrumented_run() {
     assert_eq!(stats[0].node, "facing");
     assert_eq!(stats[0].calls, solved.refine_stats.oracle_calls, "the start node sees every oracle call");
     let facing_yes = stats[0].answers.iter().find(|(a, _)| a == "Yes").map_or(0, |x| x.1);
-    assert_eq!(stats[1].calls, facing_yes, "`energy` is reached exactly by facing's `Yes`");
+    assert_eq!(stats[1].calls, facing_yes, "`near` is reached exactly by facing's `Yes`");
     assert!(format_stats(&stats).contains("facing"));
 
     let trace = dag.probe().trace();
     assert!(!trace.is_empty(), "the traced pair was evaluated");
     assert_eq!(trace[0].node, 0);
     let text = format_trace(&graph, &trace);
-    assert!(text.starts_with("facing: Facing -> Yes => energy"), "{text}");
+    assert!(text.starts_with("facing: Facing -> Yes => near"), "{text}");
     assert!(text.lines().last().is_some_and(|l| l.contains("=> link")), "the linked pair ends in `link`: {text}");
 }
 
@@ -157,16 +157,30 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
     let scene = radiosity::scene::cornell_box();
     let h = hierarchy::build(&scene, &BuildConfig::default());
     let caster = RayCaster::new(&scene);
-    let radiosity = vec![[1.0; 3]; h.len()];
+    let data = ElementData::first_guess(&h);
     let services = Services {
         hierarchy: &h,
         caster: Some(&caster),
         visibility: VisibilityConfig::default(),
-        radiosity: &radiosity,
-        b_ref: 1.0,
+        data: &data,
+        threshold_scale: 1.0,
         shafts: None,
     };
-    let bf = DagOracle::new(parse_graph(BF_TOML, Path::new("bf.toml")).expect("valid"), &[]).expect("valid");
+    // The energy part of BF: facing, transfer, subdivision; no visibility tool.
+    let energy = GraphBuilder::new("energy")
+        .start("facing")
+        .node("facing", "Facing", &[])
+        .arm(&["No"], "stop")
+        .arm(&["Yes"], "energy")
+        .node("energy", "BfAbove", &[0.01.into()])
+        .arm(&["No"], "link")
+        .arm(&["Yes"], "size")
+        .node("size", "CanSubdivide", &[0.0.into()])
+        .arm(&["Neither"], "link")
+        .arm(&["Emitter", "Both"], "subdivide_emitter")
+        .arm(&["Receiver"], "subdivide_receiver")
+        .build();
+    let energy = DagOracle::new(energy, &[]).expect("valid");
     let vis = GraphBuilder::new("vis")
         .start("v")
         .node("v", "RayVisibility", &[4.0.into()])
@@ -183,13 +197,13 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
                 continue;
             }
             let mut ctx = LinkCtx::new(&services, s, r);
-            let _ = bf.decide(&mut ctx);
-            assert!(ctx.data.visibility.is_none(), "BF stored visibility for {s} -> {r}");
+            let _ = energy.decide(&mut ctx);
+            assert!(ctx.data.visibility.is_none(), "the energy graph stored visibility for {s} -> {r}");
             decisions += 1;
         }
     }
     assert!(decisions > 10);
-    assert_eq!(caster.rays_cast(), 0, "BF cast rays");
+    assert_eq!(caster.rays_cast(), 0, "the energy graph cast rays");
     let mut ctx = LinkCtx::new(&services, 0, 1);
     let d = vis.decide(&mut ctx);
     assert!(caster.rays_cast() > 0 && ctx.data.visibility.is_some(), "a visibility graph casts rays");

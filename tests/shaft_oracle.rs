@@ -88,22 +88,38 @@ fn the_dag_runtime_runs_the_shaft_oracle_as_the_macro_does() {
 }
 
 /// `oracle explain shaft` shows the shaft's class and candidate count in the track. On the Cornell
-/// box the link from element 0 to element 23 is one the oracle classifies (partial) and splits.
+/// box some polygon pair reaches the shaft node (its transfer is above the threshold) and has a
+/// partly occluded shaft (the boxes stand between the light, the walls and the floor).
 #[test]
 fn the_explained_track_shows_the_shaft() {
     use radiosity::oracle::{registry, runtime::format_trace};
     let scene = radiosity::scene::cornell_box();
-    let (graph, trace) = registry::explain("shaft", &[], &scene, &Config::default(), 0, 23).expect("built-in oracle");
-    assert!(!trace.is_empty(), "the pair 0 -> 23 was asked");
-    let text = format_trace(&graph, &trace);
-    let shaft_step = trace.iter().find(|s| graph.nodes[s.node].tool.name == "ShaftClassify").expect("the shaft was classified");
-    assert!(shaft_step.shaft.is_some(), "{text}");
-    assert!(text.contains("shaft=partial ("), "{text}");
+    let n = scene.polygons.len() as u32;
+    let config = Config { levels: 1, ..Config::default() };
+    let mut found = None;
+    'search: for e in 0..n {
+        for r in 0..n {
+            if e == r {
+                continue;
+            }
+            let (graph, trace) = registry::explain("shaft", &[], &scene, &config, e, r).expect("built-in oracle");
+            if let Some(step) = trace.iter().find(|s| graph.nodes[s.node].tool.name == "ShaftClassify") {
+                let text = format_trace(&graph, &trace);
+                if text.contains("shaft=partial (") {
+                    assert!(step.shaft.is_some(), "{text}");
+                    found = Some((e, r, text));
+                    break 'search;
+                }
+            }
+        }
+    }
+    let (e, r, text) = found.expect("some pair's shaft is partly occluded");
+    assert!(text.contains("ShaftClassify -> Partial"), "{e} -> {r}: {text}");
 }
 
-/// A graph file may use the shaft tools. The file is BF's graph file with the shaft oracle's two
-/// shaft nodes between BF's energy test and the split (the shaft oracle's graph), and the runtime
-/// gives it shafts and the release's links.
+/// The shaft oracle's graph as a graph file: BF's graph file with the shaft classification after
+/// the transfer test, a fully visible shaft skipping the visibility test. The runtime gives it
+/// shafts and the release's links.
 #[test]
 fn a_graph_file_with_shaft_tools_gets_shafts() {
     use radiosity::oracle::bf::BF_TOML;
@@ -113,18 +129,35 @@ fn a_graph_file_with_shaft_tools_gets_shafts() {
 [[node]]
 name = "shaft"
 tool = "ShaftClassify"
-arms = [{ on = "Invisible", to = "stop" }, { on = "Visible", to = "error" }, { on = "Partial", to = "error" }]
+arms = [{ on = "Invisible", to = "stop" }, { on = "Visible", to = "open" }, { on = "Partial", to = "cluster" }]
 
 [[node]]
-name = "error"
-tool = "ShaftFfError"
+name = "open"
+tool = "ClusterError"
 args = ["eps"]
-arms = [{ on = "Below", to = "link" }, { on = "Above", to = "size" }]
+arms = [{ on = "Above", to = "size" }, { on = "Below", to = "open_variation" }]
+
+[[node]]
+name = "open_variation"
+tool = "SourceVariation"
+args = ["eps"]
+arms = [{ on = "Above", to = "open_source" }, { on = "Below", to = "link" }]
+
+[[node]]
+name = "open_source"
+tool = "CanSubdivide"
+args = ["min_area"]
+arms = [
+    { on = "Neither", to = "link" },
+    { on = "Emitter", to = "subdivide_emitter" },
+    { on = "Receiver", to = "link" },
+    { on = "Both", to = "subdivide_emitter" },
+]
 "#;
-    let energy_to_size = r#"arms = [{ on = "No", to = "link" }, { on = "Yes", to = "size" }]"#;
-    assert!(BF_TOML.contains(energy_to_size), "BF's energy node splits when above eps");
-    let energy_to_shaft = energy_to_size.replace(r#"to = "size" }]"#, r#"to = "shaft" }]"#);
-    let shaft_toml = BF_TOML.replacen(energy_to_size, &energy_to_shaft, 1) + SHAFT_NODES;
+    let transfer_to_cluster = r#"arms = [{ on = "No", to = "link" }, { on = "Yes", to = "cluster" }]"#;
+    assert!(BF_TOML.contains(transfer_to_cluster), "BF's transfer node goes on to the cluster test");
+    let transfer_to_shaft = transfer_to_cluster.replace(r#"to = "cluster" }]"#, r#"to = "shaft" }]"#);
+    let shaft_toml = BF_TOML.replacen(transfer_to_cluster, &transfer_to_shaft, 1) + SHAFT_NODES;
     let graph = parse_graph(&shaft_toml, std::path::Path::new("shaft.toml")).expect("valid graph file");
     let dag = DagOracle::new(graph, &[]).expect("built-in tools only");
     assert!(dag.needs().shafts);
@@ -133,4 +166,6 @@ arms = [{ on = "Below", to = "link" }, { on = "Above", to = "size" }]
     let (a, b) = (pipeline::run(&scene, &release, &Config::default(), &|_| {}), pipeline::run(&scene, &dag, &Config::default(), &|_| {}));
     assert!(b.shaft_classified.iter().sum::<u64>() > 0, "the file's shaft tools classified shafts");
     assert_eq!(a.links.len(), b.links.len());
+    let (pa, pb) = (polygon_results(&a.hierarchy, &a.solution), polygon_results(&b.hierarchy, &b.solution));
+    assert!(pa.iter().zip(&pb).all(|(x, y)| x.b == y.b), "same decisions give the same solution");
 }

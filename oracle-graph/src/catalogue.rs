@@ -30,6 +30,8 @@ pub enum Slot {
     Mark,
     /// The shaft classification and candidate occluders.
     Shaft,
+    /// How strongly the emitter's radiosity variation shows at the receiver.
+    SourceVariationWeight,
 }
 
 impl Slot {
@@ -44,6 +46,7 @@ impl Slot {
             Slot::Axis => "axis",
             Slot::Mark => "mark",
             Slot::Shaft => "shaft",
+            Slot::SourceVariationWeight => "source_variation_weight",
         }
     }
 }
@@ -95,7 +98,31 @@ pub const BUILTIN_TOOLS: &[ToolInfo] = &[
         answers: YES_NO,
         args: &[ArgSpec { name: "eps", ty: F64 }],
         slots: &[Slot::FormFactorMax],
-        doc: "is B_S · F_max above eps · B_ref (the classic BF criterion)",
+        doc: "is B_S · F_max above eps times the receiver's irradiance (the BF criterion, relative to the receiver)",
+    },
+    ToolInfo {
+        name: "SourceVariation",
+        kind: ToolKind::Question,
+        answers: &["Above", "Below"],
+        args: &[ArgSpec { name: "eps", ty: F64 }],
+        slots: &[Slot::SourceVariationWeight],
+        doc: "is F · (unevenness of the kernel over the source) · (variation of the source's radiosity) / 4 above eps times the receiver's irradiance",
+    },
+    ToolInfo {
+        name: "PartialVisibility",
+        kind: ToolKind::Question,
+        answers: &["Above", "Below"],
+        args: &[ArgSpec { name: "eps", ty: F64 }],
+        slots: &[Slot::FormFactorMax, Slot::Visibility],
+        doc: "is 2 V (1 - V) · rho_R · B_S · F_max (a partly visible link's error in the light the receiver reflects) above eps times the receiver's irradiance",
+    },
+    ToolInfo {
+        name: "ClusterError",
+        kind: ToolKind::Question,
+        answers: &["Above", "Below"],
+        args: &[ArgSpec { name: "eps", ty: F64 }],
+        slots: &[Slot::FormFactor],
+        doc: "is the cluster approximation's error, B_S · F · ((r_S + r_R) / d)², above eps times the receiver's irradiance",
     },
     ToolInfo {
         name: "IrradianceChange",
@@ -103,7 +130,7 @@ pub const BUILTIN_TOOLS: &[ToolInfo] = &[
         answers: &["Significant", "Negligible"],
         args: &[ArgSpec { name: "threshold", ty: F64 }],
         slots: &[Slot::FormFactor],
-        doc: "would the link change the receiver's irradiance by more than threshold · B_ref",
+        doc: "would the link change the receiver's irradiance by more than threshold times itself",
     },
     ToolInfo {
         name: "FfGradient",
@@ -143,7 +170,7 @@ pub const BUILTIN_TOOLS: &[ToolInfo] = &[
         answers: &["Above", "Below"],
         args: &[ArgSpec { name: "eps", ty: F64 }],
         slots: &[Slot::FormFactorMax, Slot::FormFactorRange, Slot::Shaft],
-        doc: "is B_S · (F_max - F_min) above eps · B_ref, F_min = 0 unless the shaft is empty (needs shafts)",
+        doc: "is B_S · (F_max - F_min) above eps times the receiver's irradiance, F_min = 0 unless the shaft is empty (needs shafts)",
     },
     ToolInfo {
         name: "Facing",

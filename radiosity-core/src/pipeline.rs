@@ -3,7 +3,7 @@
 
 use crate::analysis::SceneTraits;
 use crate::hierarchy::{self, BuildConfig, Hierarchy};
-use crate::refine::{self, Link, Oracle, RefineStats};
+use crate::refine::{self, ElementData, Link, Oracle, RefineStats};
 use crate::scene::Scene;
 use crate::solve::{self, Solution, SolveConfig};
 use crate::visibility::{RayCaster, VisibilityConfig};
@@ -19,8 +19,23 @@ pub struct Config {
     pub visibility: VisibilityConfig,
     /// Linear solver.
     pub solve: SolveConfig,
-    /// Most refine → solve rounds (refinement stops earlier when a round subdivides nothing).
+    /// Most refine → solve rounds per level (a level stops earlier when a round subdivides nothing).
     pub max_passes: usize,
+    /// Refinement levels, coarse to fine: level `k` of `n` scales every threshold of the oracle by
+    /// `level_step^(n − 1 − k)`, so the last one refines to the oracle's eps. Each level reuses the
+    /// hierarchy and links of the one before and ends with a solve; the differences between the
+    /// levels' polygon means give the error estimate ([`crate::solve::LevelHistory`]).
+    pub levels: usize,
+    /// Ratio of the thresholds of consecutive levels.
+    pub level_step: f64,
+    /// Refine level after level (thresholds falling by `level_step`, from the first level's) until
+    /// the error estimate is below this, instead of stopping at the oracle's eps.
+    pub target_error: Option<f64>,
+    /// Most levels a target error may take.
+    pub max_levels: usize,
+    /// Memory refinement may use (bytes, estimated): beyond it no link is subdivided any more
+    /// (see [`refine::RefineLimits`]); the leaf-resolution solve stays within what is left.
+    pub max_memory_bytes: usize,
     /// Cast rays for visibility (false: every link is taken as fully visible).
     pub use_visibility: bool,
     /// How link visibility is computed.
@@ -28,16 +43,29 @@ pub struct Config {
     /// Analyse the scene first and leave out what it does not need (visibility in a convex
     /// enclosure); see [`crate::analysis`].
     pub analyse: bool,
-    /// After the last hierarchical solve, solve again at leaf resolution (every leaf gathers from
-    /// its chain of links with its own form factors, see [`solve::LeafOperator`]); when that would
-    /// store more than `leaf_operator_max_entries` coefficients, one gather pass is done instead.
+    /// After the last hierarchical solve of a level, solve again at leaf resolution (every leaf
+    /// gathers from its chain of links with its own form factors, see [`solve::LeafOperator`]);
+    /// when that would store more than `leaf_operator_max_entries` coefficients, one gather pass is
+    /// done instead.
     pub final_gather: bool,
     /// Budget of the leaf-resolution operator (coefficients, 12 bytes each).
     pub leaf_operator_max_entries: usize,
-    /// Estimate the solution's error after the solve ([`Solved::error_estimate`]); costs a
-    /// full-resolution gather at sampled leaves, which dominates small solves.
+    /// Estimate the solution's error ([`Solved::error_estimate`]).
     pub estimate_error: bool,
+    /// Measure each element's radiosity variation after every solve ([`solve::element_data`]), for
+    /// oracles whose criteria read it (off: only the radiosity is updated).
+    pub measure_variation: bool,
+    /// Find out whether the scene is closed ([`crate::visibility::escape_fraction`]) and, if so,
+    /// deliver each surface's light whole ([`solve::LeafCoefficients::for_cut`]).
+    pub detect_closure: bool,
 }
+
+/// Default number of refinement levels ([`Config::levels`]).
+pub const DEFAULT_LEVELS: usize = 3;
+/// Default ratio of consecutive levels' thresholds ([`Config::level_step`]).
+pub const DEFAULT_LEVEL_STEP: f64 = 4.0;
+/// Default most levels of a target error ([`Config::max_levels`]).
+pub const DEFAULT_MAX_LEVELS: usize = 10;
 
 impl Default for Config {
     fn default() -> Self {
@@ -45,15 +73,45 @@ impl Default for Config {
             build: BuildConfig::default(),
             visibility: VisibilityConfig::default(),
             solve: SolveConfig::default(),
-            max_passes: 3,
+            max_passes: 2,
+            levels: DEFAULT_LEVELS,
+            level_step: DEFAULT_LEVEL_STEP,
+            target_error: None,
+            max_levels: DEFAULT_MAX_LEVELS,
+            max_memory_bytes: default_memory_budget(),
             use_visibility: true,
             analyse: true,
             visibility_method: VisibilityMethod::Rays,
             final_gather: true,
             leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
             estimate_error: true,
+            measure_variation: true,
+            detect_closure: true,
         }
     }
+}
+
+/// A scene whose [`crate::visibility::escape_fraction`] is at most this is closed (a ray or two
+/// of the 4,096 may slip through a shared edge).
+pub const CLOSED_MAX_ESCAPE: f64 = 2.0 / crate::visibility::ESCAPE_SAMPLES as f64;
+
+/// Fraction of the machine's physical memory refinement may use by default.
+pub const DEFAULT_MEMORY_FRACTION: f64 = 0.5;
+
+/// The default memory budget: [`DEFAULT_MEMORY_FRACTION`] of physical memory (`MemTotal` of
+/// `/proc/meminfo`), or 4 GB where that cannot be read.
+#[must_use]
+pub fn default_memory_budget() -> usize {
+    physical_memory_bytes().map_or(4_000_000_000, |m| (m as f64 * DEFAULT_MEMORY_FRACTION) as usize)
+}
+
+/// Physical memory in bytes, from `/proc/meminfo` (Linux).
+#[must_use]
+pub fn physical_memory_bytes() -> Option<usize> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kb: usize = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 /// How link visibility is computed.
@@ -108,9 +166,11 @@ pub struct Timings {
 /// Progress events for front ends.
 #[derive(Clone, Copy, Debug)]
 pub enum Progress {
-    /// Refinement pass `pass`: `links` kept so far, `pending` candidates.
+    /// Refinement pass `pass` of level `level`: `links` kept so far, `pending` candidates.
     Refine {
-        /// Pass number from 1.
+        /// Level number from 1.
+        level: usize,
+        /// Pass number from 1 within the level.
         pass: usize,
         /// Links so far.
         links: u64,
@@ -131,6 +191,33 @@ pub enum Progress {
         /// Relative residual.
         residual: f64,
     },
+    /// A level finished.
+    Level {
+        /// Level number from 1.
+        level: usize,
+        /// Its figures.
+        report: LevelReport,
+    },
+}
+
+/// What one refinement level cost and gave.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct LevelReport {
+    /// The oracle's thresholds were scaled by this (1 at the oracle's own eps).
+    pub threshold_scale: f64,
+    /// Elements after the level.
+    pub elements: usize,
+    /// Leaves after the level.
+    pub leaves: usize,
+    /// Links after the level.
+    pub links: usize,
+    /// Largest change of a non-emitting polygon mean since the level before, relative to the
+    /// largest such mean (`None` for the first level).
+    pub change: Option<f64>,
+    /// The error estimate after this level (`None` until two levels are solved).
+    pub error_estimate: Option<f64>,
+    /// Wall time since the solve started, seconds.
+    pub time_s: f64,
 }
 
 /// The result of [`run`].
@@ -147,8 +234,10 @@ pub struct Solved {
     pub refine_stats: RefineStats,
     /// Rays cast during refinement.
     pub rays: u64,
-    /// Refine → solve rounds done.
+    /// Refine → solve rounds done, over every level.
     pub passes: usize,
+    /// What each refinement level cost and gave, coarse to fine.
+    pub levels: Vec<LevelReport>,
     /// Coefficients of the leaf-resolution operator (0 when it was not used).
     pub leaf_entries: usize,
     /// Links that shaft culling classified [invisible, visible] without casting a ray.
@@ -157,17 +246,31 @@ pub struct Solved {
     pub traits: Option<SceneTraits>,
     /// Machinery left out for this scene, in words.
     pub left_out: Vec<String>,
-    /// A-posteriori error estimate, relative to the largest leaf radiosity: the one-step residual
-    /// against a full-resolution gather at sampled leaves (see [`solve::error_estimate`]); `None`
-    /// when [`Config::estimate_error`] is off.
+    /// Estimated largest error of a non-emitting polygon's mean radiosity (every channel), relative
+    /// to the largest non-emitting polygon mean, from the levels' solutions (see
+    /// [`solve::LevelHistory`]); `None` when [`Config::estimate_error`] is off or one level was
+    /// solved.
     pub error_estimate: Option<f64>,
+    /// Whether refinement stopped short for the memory budget ([`Config::max_memory_bytes`]).
+    pub memory_limited: bool,
+    /// The fraction of the light leaving the surfaces that escapes the scene, sampled
+    /// ([`crate::visibility::escape_fraction`]).
+    pub escape_fraction: f64,
+    /// Whether the scene is closed ([`CLOSED_MAX_ESCAPE`]): every surface's light then lands on
+    /// another, and the leaf-resolution solve delivers it whole.
+    pub closed: bool,
+    /// What the solve could not do as asked, in words (memory budget reached, target error not
+    /// reached).
+    pub warnings: Vec<String>,
     /// Operator applications summed over passes.
     pub iterations: usize,
     /// Time per phase.
     pub timings: Timings,
 }
 
-/// Solves `scene` with `oracle`.
+/// Solves `scene` with `oracle`: level after level, coarse to fine ([`Config::levels`], or until
+/// [`Config::target_error`]), each a few refine → solve rounds ending with the leaf-resolution
+/// solve.
 pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn Fn(Progress)) -> Solved {
     let t0 = Instant::now();
     let traits = config.analyse.then(|| SceneTraits::of(scene));
@@ -189,56 +292,120 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         invisible: &shaft_invisible,
         visible: &shaft_visible,
     });
+    // A closed scene delivers every bit of each surface's light to another: the leaf-resolution
+    // solves then make it so exactly (see `solve::LeafCoefficients::for_cut`).
+    let escape_fraction =
+        if config.detect_closure { crate::visibility::escape_fraction(&h, &caster, config.visibility.seed) } else { f64::NAN };
+    let closed = escape_fraction <= CLOSED_MAX_ESCAPE;
     let mut timings = Timings { build: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
-    let mut radiosity = initial_radiosity(&h);
-    // Thresholds are relative to the brightest radiosity expected (emission plus the closed-scene
-    // ambient estimate), so the same eps means the same relative accuracy in a dim room and in a
-    // stiff enclosure where B is 1/(1−ρ) times the emission.
-    let b_ref = radiosity.iter().flat_map(|e| e.iter().copied()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+    // Thresholds are relative to each receiver's own irradiance (see `refine::ElementData`): the
+    // first pass starts from a guess, every later one reads the last solution.
+    let mut data = ElementData::first_guess(&h);
+    let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
+    let mut history = solve::LevelHistory::new(emitting);
     let mut links = Vec::new();
     let mut stats = RefineStats::default();
     let mut solution = None;
     let mut passes = 0;
     let mut iterations = 0;
-    for pass in 1..=config.max_passes.max(1) {
-        let t = Instant::now();
-        let (new_links, s) = refine::refine(
-            &mut h,
-            use_visibility.then_some(&caster),
-            config.visibility,
-            oracle,
-            links,
-            &mut radiosity,
-            b_ref,
-            shafts,
-            &|l, p| progress(Progress::Refine { pass, links: l, pending: p }),
-        );
-        links = new_links;
-        timings.refine += t.elapsed().as_secs_f64();
-        stats.oracle_calls += s.oracle_calls;
-        stats.form_factors += s.form_factors;
-        stats.subdivided += s.subdivided;
-        stats.dropped += s.dropped;
-        stats.links = s.links;
-        passes = pass;
-        if pass > 1 && s.subdivided == 0 {
-            break;
+    let mut levels = Vec::new();
+    let mut leaf_entries = 0;
+    let n_levels = if config.target_error.is_some() { config.max_levels.max(1) } else { config.levels.max(1) };
+    // Without a target the last level is at the oracle's eps; with one, the levels run on from the
+    // same first level until the estimate is below the target.
+    let first_scale = config.level_step.powi(config.levels.max(1) as i32 - 1);
+    for level in 0..n_levels {
+        let scale = first_scale / config.level_step.powi(level as i32);
+        let limits = refine::RefineLimits { max_bytes: config.max_memory_bytes };
+        let mut level_solution = None;
+        for pass in 1..=config.max_passes.max(1) {
+            let t = Instant::now();
+            let (new_links, s) = refine::refine(
+                &mut h,
+                use_visibility.then_some(&caster),
+                config.visibility,
+                oracle,
+                links,
+                &mut data,
+                scale,
+                shafts,
+                limits,
+                &|l, p| progress(Progress::Refine { level: level + 1, pass, links: l, pending: p }),
+            );
+            links = new_links;
+            timings.refine += t.elapsed().as_secs_f64();
+            stats.oracle_calls += s.oracle_calls;
+            stats.form_factors += s.form_factors;
+            stats.subdivided += s.subdivided;
+            stats.dropped += s.dropped;
+            stats.refused_for_memory += s.refused_for_memory;
+            stats.links = s.links;
+            passes += 1;
+            if pass > 1 && s.subdivided == 0 && level_solution.is_some() {
+                break;
+            }
+            let t = Instant::now();
+            let sol = solve::solve(&h, &links, &data.radiosity, &config.solve);
+            timings.solve += t.elapsed().as_secs_f64();
+            iterations += sol.iterations;
+            progress(Progress::Solved { pass: passes, iterations: sol.iterations, residual: sol.residual });
+            if pass < config.max_passes.max(1) {
+                update_data(&mut data, &h, &links, &sol, config);
+            }
+            level_solution = Some(sol);
         }
         let t = Instant::now();
-        let sol = solve::solve(&h, &links, &radiosity, &config.solve);
+        let sol = level_solution.expect("every level solves at least once");
+        let budget = config.max_memory_bytes.saturating_sub(h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK);
+        let leaf_budget = config.leaf_operator_max_entries.min(budget / solve::LEAF_OPERATOR_ENTRY_BYTES);
+        let (sol, more_iterations, entries) = finish_solve(&h, &links, sol, config, leaf_budget, closed, progress, passes, &mut None);
+        iterations += more_iterations;
+        leaf_entries = entries;
         timings.solve += t.elapsed().as_secs_f64();
-        iterations += sol.iterations;
-        progress(Progress::Solved { pass, iterations: sol.iterations, residual: sol.residual });
-        radiosity.clone_from(&sol.radiosity);
+        if level + 1 < n_levels {
+            update_data(&mut data, &h, &links, &sol, config);
+        }
+        let means: Vec<[f64; 3]> = crate::output::polygon_results(&h, &sol).into_iter().map(|r| r.b).collect();
+        let change = history.push(means);
+        let last = level + 1 == n_levels || stats.refused_for_memory > 0;
+        let estimate = (config.estimate_error && entries > 0 && (config.target_error.is_some() || last))
+            .then(|| estimate_error(&h, &links, &sol, closed, config));
+        let report = LevelReport {
+            threshold_scale: scale,
+            elements: h.len(),
+            leaves: h.leaves().count(),
+            links: links.len(),
+            change,
+            error_estimate: estimate,
+            time_s: t0.elapsed().as_secs_f64(),
+        };
+        progress(Progress::Level { level: level + 1, report });
+        levels.push(report);
         solution = Some(sol);
+        let reached = match (config.target_error, estimate) {
+            (Some(target), Some(e)) => e <= target,
+            _ => false,
+        };
+        if reached || stats.refused_for_memory > 0 {
+            break;
+        }
     }
-    let solution = solution.expect("at least one pass solves");
-    let t = Instant::now();
-    let (solution, more_iterations, leaf_entries) = finish_solve(&h, &links, solution, config, progress, passes, &mut None);
-    iterations += more_iterations;
-    timings.solve += t.elapsed().as_secs_f64();
-    let error_estimate = config.estimate_error.then(|| solve::error_estimate(&h, &links, &solution.radiosity, &solution.irradiance));
+    let solution = solution.expect("at least one level solves");
+    let error_estimate = levels.last().and_then(|l| l.error_estimate);
+    let mut warnings = Vec::new();
+    if stats.refused_for_memory > 0 {
+        warnings.push(format!(
+            "memory budget of {:.0} MB reached: {} subdivisions refused, those links kept where they were",
+            config.max_memory_bytes as f64 / 1e6,
+            stats.refused_for_memory
+        ));
+    }
+    if let (Some(target), Some(e)) = (config.target_error, error_estimate)
+        && e > target
+    {
+        warnings.push(format!("target error {target} not reached: estimate {e:.3e} after {} levels", levels.len()));
+    }
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
     Solved {
@@ -246,9 +413,14 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         links,
         solution,
         caster,
+        memory_limited: stats.refused_for_memory > 0,
+        escape_fraction,
+        closed,
+        warnings,
         refine_stats: stats,
         rays,
         passes,
+        levels,
         leaf_entries,
         shaft_classified,
         traits,
@@ -257,6 +429,35 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         iterations,
         timings,
     }
+}
+
+/// What the next refinement pass reads of solution `sol`: everything ([`solve::element_data`]), or
+/// only the radiosity when [`Config::measure_variation`] is off.
+fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solution, config: &Config) {
+    if config.measure_variation {
+        *data = solve::element_data(h, links, sol);
+    } else {
+        data.radiosity.clone_from(&sol.radiosity);
+    }
+}
+
+/// The error estimate of the leaf-resolution solution `sol` (see [`solve::richardson_estimate`]):
+/// the same links solved on the mesh one and two levels coarser ([`solve::Cut::coarsened`]), the
+/// Richardson extrapolation of the three, with the visibility-sampling noise
+/// ([`solve::visibility_noise`]) where that is larger, times [`solve::ESTIMATE_SAFETY`].
+fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config) -> f64 {
+    let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
+    let mut means = vec![crate::output::polygon_results(h, sol).into_iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
+    for levels in 1..=2 {
+        let cut = solve::Cut::coarsened(h, levels);
+        let coefficients = solve::LeafCoefficients::for_cut(&cut, links, closed);
+        let op = solve::LeafOperator::for_cut(cut, &coefficients);
+        let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
+        means.push(crate::output::polygon_results(h, &coarse).into_iter().map(|r| r.b).collect());
+    }
+    let mesh = solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]);
+    let noise = solve::visibility_noise(h, links, &sol.radiosity, config.visibility.rays);
+    solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
 }
 
 /// The visibility method a solve with `oracle` uses: `requested`, except that an oracle that needs
@@ -278,20 +479,23 @@ pub fn effective_visibility(oracle: &dyn Oracle, requested: VisibilityMethod) ->
 /// iterations and the leaf-operator entries (0 when gathered).
 #[must_use]
 pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
-    let sol = solve::solve(h, links, &initial_radiosity(h), &config.solve);
+    let sol = solve::solve(h, links, &ElementData::first_guess(h).radiosity, &config.solve);
     let first = sol.iterations;
-    let (sol, more, entries) = finish_solve(h, links, sol, config, &|_| {}, 1, leaf);
+    let (sol, more, entries) = finish_solve(h, links, sol, config, config.leaf_operator_max_entries, false, &|_| {}, 1, leaf);
     (sol, first + more, entries)
 }
 
 /// The final gather step after the hierarchical solve, with the leaf-resolution coefficients of
-/// `leaf` (computed and kept there when absent and within budget): `(solution, iterations, leaf
-/// entries)`.
+/// `leaf` (computed and kept there when absent and within `max_entries`): `(solution, iterations,
+/// leaf entries)`.
+#[allow(clippy::too_many_arguments)]
 fn finish_solve(
     h: &Hierarchy,
     links: &[Link],
     mut solution: Solution,
     config: &Config,
+    max_entries: usize,
+    closed: bool,
     progress: &dyn Fn(Progress),
     passes: usize,
     leaf: &mut Option<solve::LeafCoefficients>,
@@ -301,9 +505,9 @@ fn finish_solve(
     }
     if leaf.is_none() {
         let entries = solve::leaf_operator_entries(h, links);
-        if entries <= config.leaf_operator_max_entries {
+        if entries <= max_entries {
             progress(Progress::LeafSolve { entries });
-            *leaf = Some(solve::LeafCoefficients::new(h, links));
+            *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed));
         }
     }
     match leaf {
@@ -321,45 +525,6 @@ fn finish_solve(
             (solution, 0, 0)
         }
     }
-}
-
-/// First guess for the energy criteria: emission plus a uniform ambient term (the closed-scene
-/// estimate `Φ / (A (1 − ρ̄))`), reflected by each polygon.
-fn initial_radiosity(h: &Hierarchy) -> Vec<[f64; 3]> {
-    let n = h.n_polygons as usize;
-    let mut power = [0.0; 3];
-    let mut area = 0.0;
-    let mut rho_area = [0.0; 3];
-    for p in 0..n {
-        let a = h.get(p as u32).area;
-        area += a;
-        for c in 0..3 {
-            power[c] += a * h.emission[p][c];
-            rho_area[c] += a * h.reflectance[p][c];
-        }
-    }
-    let ambient: [f64; 3] = std::array::from_fn(|c| if area > 0.0 { power[c] / area / (1.0 - rho_area[c] / area).max(1e-3) } else { 0.0 });
-    let mut b = vec![[0.0; 3]; h.len()];
-    for p in 0..n {
-        b[p] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * ambient[c]);
-    }
-    // Clusters: area-weighted means, children before parents. The build reserves a cluster's slot
-    // before building its children (pre-order), so every descendant of a cluster has a larger id:
-    // going down the ids reaches the children first.
-    for e in (n..h.len()).rev() {
-        let el = h.get(e as u32);
-        if el.is_cluster() {
-            let mut acc = [0.0; 3];
-            for &k in h.children_of(e as u32) {
-                let a = h.get(k).area;
-                for c in 0..3 {
-                    acc[c] += a * b[k as usize][c];
-                }
-            }
-            b[e] = acc.map(|v| if el.area > 0.0 { v / el.area } else { 0.0 });
-        }
-    }
-    b
 }
 
 #[cfg(test)]
@@ -382,7 +547,7 @@ mod tests {
     fn initial_radiosity_of_clusters_is_the_mean_of_their_polygons() {
         let scene = crate::scene::cornell_box();
         let h = hierarchy::build(&scene, &hierarchy::BuildConfig { max_leaf_polygons: 2, ..Default::default() });
-        let b = initial_radiosity(&h);
+        let b = ElementData::first_guess(&h).radiosity;
         let mut clusters = 0;
         for e in 0..h.len() as u32 {
             let crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } = h.get(e).kind else { continue };

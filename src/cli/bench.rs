@@ -25,6 +25,10 @@ pub enum BenchCommand {
     /// What leaving out unneeded machinery saves: each scene solved with and without the scene
     /// analysis.
     LeaveOut(LeaveOutArgs),
+    /// The validation scenes (exact or independently computed answers) at a range of eps and at
+    /// the default target error: time, peak RSS, leaves, links, true error, estimate, power
+    /// balance.
+    Accuracy(super::bench_accuracy::AccuracyBenchArgs),
 }
 
 /// Arguments of `bench shafts`.
@@ -134,6 +138,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Oracle(args) => bench_oracle(&args),
         BenchCommand::Instancing(args) => bench_instancing(&args),
         BenchCommand::Shafts(args) => bench_shafts(&args),
+        BenchCommand::Accuracy(args) => super::bench_accuracy::run(&args),
     }
 }
 
@@ -301,7 +306,7 @@ fn child_solve(
     cmd.arg(scene);
     cmd.args([
         "--eps",
-        &o.eps.to_string(),
+        &o.eps().to_string(),
         "--rays",
         &o.common.rays.to_string(),
         "--seed",

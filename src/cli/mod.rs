@@ -1,6 +1,7 @@
 //! Subcommands.
 
 mod bench;
+mod bench_accuracy;
 mod generate;
 mod oracle;
 mod progress;
@@ -58,13 +59,23 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 /// Options shared by the commands that solve.
 #[derive(clap::Args, Debug, Clone)]
 pub struct SolveOptions {
-    /// Refinement threshold: links are refined while B·F exceeds eps times the brightest expected
-    /// radiosity.
-    #[arg(long, default_value_t = radiosity::refine::BfParams::default().eps)]
-    pub eps: f64,
+    /// Refinement threshold: every error term of a link is kept below eps times its receiver's
+    /// irradiance (divided by how often light is reflected in the scene). With --eps and no
+    /// --target-error, refinement stops at this eps; with --target-error it is where the levels
+    /// start from (divided by 4 per level, after two levels at 16 and 4 times it).
+    #[arg(long)]
+    pub eps: Option<f64>,
+    /// Refine, level after level, until the estimated error (the largest error of a non-emitting
+    /// polygon's mean radiosity relative to the largest such mean) is below this. The default when
+    /// --eps is not given: 0.01.
+    #[arg(long, value_name = "X")]
+    pub target_error: Option<f64>,
     #[command(flatten)]
     pub common: CommonOptions,
 }
+
+/// The target error of a solve given neither `--eps` nor `--target-error`.
+pub const DEFAULT_TARGET_ERROR: f64 = 0.01;
 
 /// Solver options other than the threshold.
 #[derive(clap::Args, Debug, Clone)]
@@ -88,18 +99,40 @@ pub struct CommonOptions {
     /// `hull` bounding volumes.
     #[arg(long, default_value = "rays", value_parser = ["rays", "aabb", "obb", "hull"])]
     pub visibility: String,
+    /// Memory refinement may use, MB (default: half the machine's physical memory): beyond it no
+    /// link is subdivided any more, and stats.json says so.
+    #[arg(long, value_name = "MB")]
+    pub max_memory: Option<f64>,
 }
 
 impl SolveOptions {
     /// Checks the values clap cannot.
     pub fn validate(&self) -> anyhow::Result<()> {
-        anyhow::ensure!(self.eps.is_finite() && self.eps > 0.0, "--eps must be a positive number, got {}", self.eps);
+        if let Some(eps) = self.eps {
+            anyhow::ensure!(eps.is_finite() && eps > 0.0 && eps <= 1.0, "--eps must be a number in (0, 1], got {eps}");
+        }
+        if let Some(t) = self.target_error {
+            anyhow::ensure!(t.is_finite() && t > 0.0 && t < 1.0, "--target-error must be a number in (0, 1), got {t}");
+        }
         self.common.validate()
+    }
+
+    /// The oracle's eps: `--eps`, or the BF default.
+    pub fn eps(&self) -> f64 {
+        self.eps.unwrap_or(radiosity::refine::BfParams::default().eps)
+    }
+
+    /// The target error: `--target-error`, or [`DEFAULT_TARGET_ERROR`] when neither it nor `--eps`
+    /// is given.
+    pub fn target_error(&self) -> Option<f64> {
+        self.target_error.or(if self.eps.is_none() { Some(DEFAULT_TARGET_ERROR) } else { None })
     }
 
     /// The pipeline configuration these options describe.
     pub fn config(&self) -> radiosity::pipeline::Config {
-        self.common.config()
+        let mut config = self.common.config();
+        config.target_error = self.target_error();
+        config
     }
 }
 
@@ -112,6 +145,9 @@ impl CommonOptions {
             "--min-area must be in (0, 1), got {}",
             self.min_area
         );
+        if let Some(mb) = self.max_memory {
+            anyhow::ensure!(mb.is_finite() && mb >= 1.0, "--max-memory must be at least 1 (MB), got {mb}");
+        }
         Ok(())
     }
 
@@ -125,6 +161,9 @@ impl CommonOptions {
         // clap accepts only the names `VisibilityMethod::name` gives.
         use radiosity::pipeline::VisibilityMethod;
         config.visibility_method = VisibilityMethod::from_name(&self.visibility).unwrap_or(VisibilityMethod::Rays);
+        if let Some(mb) = self.max_memory {
+            config.max_memory_bytes = (mb * 1e6) as usize;
+        }
         config
     }
 }

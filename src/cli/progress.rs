@@ -33,11 +33,17 @@ impl Reporter {
     /// Shows a pipeline event.
     pub fn event(&self, p: Progress) {
         let msg = match p {
-            Progress::Refine { pass, links, pending } => format!("refine pass {pass}: {links} links, {pending} candidates pending"),
+            Progress::Refine { level, pass, links, pending } => {
+                format!("level {level}, refine pass {pass}: {links} links, {pending} candidates pending")
+            }
             Progress::LeafSolve { entries } => format!("leaf-resolution solve: {entries} coefficients"),
             Progress::Solved { pass, iterations, residual } => {
                 format!("solve pass {pass}: {iterations} iterations, residual {residual:.1e}")
             }
+            Progress::Level { level, report } => match report.error_estimate {
+                Some(e) => format!("level {level}: {} links, estimated error {:.2}%", report.links, 100.0 * e),
+                None => format!("level {level}: {} links", report.links),
+            },
         };
         self.bar.set_message(msg);
     }

@@ -111,7 +111,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     let load = t0.elapsed().as_secs_f64();
     let mut params = super::oracle::parse_params(&args.params)?;
     if !params.iter().any(|(k, _)| k == "eps") {
-        params.push(("eps".to_string(), args.options.eps));
+        params.push(("eps".to_string(), args.options.eps()));
     }
     let oracle = radiosity::oracle::registry::oracle(&args.oracle, &params)?;
     // The method the solve will use (an oracle that needs shafts gets them), as stats.json reports it.
@@ -134,13 +134,16 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     let oracle_params: serde_json::Map<String, serde_json::Value> = params.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect();
     let params = serde_json::json!({
         "oracle": oracle_params,
-        "eps": args.options.eps,
+        "eps": args.options.eps(),
+        "target_error": config.target_error,
+        "max_memory_bytes": config.max_memory_bytes,
         "rays": args.options.common.rays,
         "seed": args.options.common.seed,
         "min_area": args.options.common.min_area,
         "visibility": if args.options.common.no_visibility { "none" } else { config.visibility_method.name() },
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
+    stats.target_error = config.target_error;
     let out_config =
         OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
@@ -184,14 +187,29 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
     } else {
         println!("left out: {}", s.left_out.join("; "));
     }
+    if s.levels.len() > 1 {
+        let steps: Vec<String> = s
+            .levels
+            .iter()
+            .map(|l| match l.error_estimate {
+                Some(e) => format!("{} links {:.3}s est {:.2}%", l.links, l.time_s, 100.0 * e),
+                None => format!("{} links {:.3}s", l.links, l.time_s),
+            })
+            .collect();
+        println!("levels: {}", steps.join(" -> "));
+    }
     if let Some(e) = s.error_estimate {
+        let target = s.target_error.map_or(String::new(), |t| format!(" (target {:.2}%)", 100.0 * t));
         println!(
-            "error estimate: {:.2}% of the largest radiosity (one-step residual against a full-resolution gather), in {:.3}s",
-            100.0 * e,
-            s.time_s.total
+            "error estimate: {:.2}%{target} of the largest non-emitting polygon mean, largest error of a polygon mean (same links on meshes 2x and 4x coarser, extrapolated)",
+            100.0 * e
         );
     }
-    println!("power: emitted {:.6e} W, absorbed {:.6e} W (ratio {:.5})", s.power_emitted, s.power_absorbed, balance);
+    let closed = if s.closed { "closed scene: each surface's light delivered whole" } else { "open scene" };
+    println!("power: emitted {:.6e} W, absorbed {:.6e} W (balance {:.5}; {closed})", s.power_emitted, s.power_absorbed, balance);
+    for w in &s.solve_warnings {
+        eprintln!("warning: {w}");
+    }
     println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());
 }
 
@@ -209,8 +227,9 @@ fn solve_instanced(
     let name = args.scene.as_ref().map_or_else(|| scene.name.clone(), |p| p.display().to_string());
     let trace = std::env::var_os("RADIOSITY_TRACE").is_some();
     let mut config = InstancedConfig { cache_dir: Some(args.out.join("prototype-cache")), trace, ..InstancedConfig::default() };
-    config.bf.eps = args.options.eps;
-    config.pipeline = args.options.config();
+    config.bf.eps = args.options.eps();
+    // Instanced solves refine each local problem to the eps (no estimate of their own).
+    config.pipeline = radiosity::pipeline::Config { target_error: None, ..args.options.config() };
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     config.instance_levels = args.instance_levels;
     config.direct_samples = args.direct_samples;
@@ -228,7 +247,7 @@ fn solve_instanced(
         doc["auto_instancing"] = serde_json::to_value(report).context("serialising the auto-instancing report")?;
     }
     doc["oracle"] = serde_json::json!("bf-hand");
-    doc["eps"] = serde_json::json!(args.options.eps);
+    doc["eps"] = serde_json::json!(args.options.eps());
     doc["tone_white"] = serde_json::json!(written.white);
     doc["time_s"] =
         serde_json::json!({ "solve": stats.seconds, "output": t_out.elapsed().as_secs_f64(), "total": t0.elapsed().as_secs_f64() });

@@ -9,9 +9,11 @@ use std::f64::consts::PI;
 
 /// Separation (centre distance over the sum of bounding radii) beyond which a surface link uses the
 /// 4-point (quads) or 3-point (triangles) rule on the receiver; nearer pairs use 9 or 6 points. A
-/// 1-point rule is biased (the kernel is convex in the distance), and its bias accumulates in stiff
-/// scenes, where the solution amplifies a row-sum error δ by ρ/(1−ρ).
-pub const FAR_SEPARATION: f64 = 4.0;
+/// 1-point rule is biased (the kernel is convex in the distance), and so, less, is the 4-point one
+/// (low by 2e-5 to 7e-5 at separation 4, by under 2.5e-5 from 8 on, against under 2e-5 for the
+/// 9-point rule from separation 1.5 on; unit squares, `examples/ff_accuracy.rs`): the bias
+/// accumulates in stiff scenes, where the solution amplifies a row-sum error δ by ρ/(1−ρ).
+pub const FAR_SEPARATION: f64 = 8.0;
 /// Separation under which a surface link uses the contour integral (of the clipped pair when one
 /// crosses the other's plane) instead of receiver quadrature.
 pub const NEAR_SEPARATION: f64 = 1.5;
@@ -21,6 +23,12 @@ pub const NEAR_SEPARATION: f64 = 1.5;
 pub enum FormFactorQuality {
     /// One point at the receiver's centre.
     Estimate,
+    /// The 4-point (quads) or 3-point (triangles) receiver rule where [`Precise`] would use more
+    /// points (low by up to 1e-2 next to the contour integral's range): for sharing a link's
+    /// transfer among the receiver's leaves, where only the ratios matter.
+    ///
+    /// [`Precise`]: FormFactorQuality::Precise
+    Shape,
     /// Receiver quadrature chosen by separation.
     Precise,
 }
@@ -42,9 +50,9 @@ pub fn estimate(h: &Hierarchy, source: u32, receiver: u32) -> f64 {
 pub const MAX_PROBE_PULL: f64 = 0.1;
 
 /// Estimate of the largest point-to-source form factor over the receiver: the maximum of the
-/// analytic value at the receiver's centre and near each of its corners. The classic BF criterion
-/// applied to this value refines where a receiver touches its source (edges, corners), which the
-/// centre value alone misses. Clusters use the conservative isotropic formula.
+/// analytic value at the receiver's centre and near each of its corners. The BF criteria applied
+/// to this value refine where a receiver touches its source (edges, corners), which the centre
+/// value alone misses. Clusters use the conservative isotropic formula.
 #[must_use]
 pub fn estimate_max(h: &Hierarchy, source: u32, receiver: u32) -> f64 {
     let (s, r) = (h.get(source), h.get(receiver));
@@ -83,11 +91,12 @@ pub fn link_form_factor(h: &Hierarchy, source: u32, receiver: u32, quality: Form
     }
     let dist = (s.center - r.center).length();
     let separation = dist / (s.radius + r.radius).max(f64::MIN_POSITIVE);
-    let rule = match (rp.kind, separation) {
-        (PolyKind::Quad, x) if x >= FAR_SEPARATION => &quadrature::QUAD_4,
-        (PolyKind::Quad, _) => &quadrature::QUAD_9,
-        (PolyKind::Triangle, x) if x >= FAR_SEPARATION => &quadrature::TRI_3,
-        (PolyKind::Triangle, _) => &quadrature::TRI_6,
+    let far = separation >= FAR_SEPARATION || (quality == FormFactorQuality::Shape && separation >= NEAR_SEPARATION);
+    let rule = match (rp.kind, far) {
+        (PolyKind::Quad, true) => &quadrature::QUAD_4,
+        (PolyKind::Quad, false) => &quadrature::QUAD_9,
+        (PolyKind::Triangle, true) => &quadrature::TRI_3,
+        (PolyKind::Triangle, false) => &quadrature::TRI_6,
     };
     if separation < NEAR_SEPARATION
         && wholly_in_front(rp.vertices(), sp.vertices(), s.normal, s.radius)
@@ -179,12 +188,17 @@ fn rule_average(rp: &Poly, rn: DVec3, sv: &[DVec3], sn: DVec3, rule: &quadrature
 pub const ON_PLANE_REL_TOL: f64 = 1e-9;
 
 /// Whether every one of `points` lies on or behind the plane of the surface element `plane`
-/// (false for a cluster, which has no plane): the facing test of refinement
+/// (false for a cluster, unless all its polygons lie in one plane facing one way): the facing test of refinement
 /// ([`crate::refine::LinkCtx::facing`]) and of [`link_form_factor`].
 #[must_use]
 pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) -> bool {
-    let Some(p) = plane.poly() else { return false };
-    let (origin, tol) = (p.v[0], ON_PLANE_REL_TOL * plane.radius);
+    let origin = match plane.poly() {
+        Some(p) => p.v[0],
+        // A flat cluster (all its polygons in one plane, one way) has its centre in that plane.
+        None if plane.normal != DVec3::ZERO => plane.center,
+        None => return false,
+    };
+    let tol = ON_PLANE_REL_TOL * plane.radius;
     points.into_iter().all(|v| plane.normal.dot(v - origin) <= tol)
 }
 
@@ -211,6 +225,27 @@ pub fn projected_area(h: &Hierarchy, e: &Element, dir: DVec3) -> f64 {
                     el.area * el.normal.dot(dir).max(0.0)
                 })
                 .sum()
+        }
+    }
+}
+
+/// The point form factor `F(dx → source)` from a small receiver at `x` with unit normal `n` to the
+/// element `source`: Lambert's formula for a surface (its front side only, clipped to `x`'s front
+/// half-space); for a cluster, its members seen as a point source at its centre, radiating
+/// `A_proj(dir) / π` per unit radiosity toward `x` (see [`projected_area`]).
+#[must_use]
+pub fn point_to_element(h: &Hierarchy, x: DVec3, n: DVec3, source: u32) -> f64 {
+    let s = h.get(source);
+    match s.poly() {
+        Some(sp) => point_polygon(x, n, sp.vertices(), s.normal),
+        None => {
+            let d = x - s.center;
+            let dist2 = d.length_squared();
+            if dist2 <= 0.0 {
+                return 0.0;
+            }
+            let dir = d / dist2.sqrt();
+            (projected_area(h, s, dir) / PI * (-n.dot(dir)).max(0.0) / dist2).min(1.0)
         }
     }
 }

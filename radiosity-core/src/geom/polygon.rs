@@ -78,6 +78,33 @@ impl Poly {
         (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(x - vs[k]).dot(n) >= 0.0).then_some(t)
     }
 
+    /// The point of the polygon (convex, edges included) nearest to `x`.
+    #[must_use]
+    pub fn nearest_point(&self, x: DVec3) -> DVec3 {
+        let n = self.normal();
+        let p = x - n * n.dot(x - self.v[0]);
+        let vs = self.vertices();
+        let inside = (0..vs.len()).all(|k| (vs[(k + 1) % vs.len()] - vs[k]).cross(p - vs[k]).dot(n) >= 0.0);
+        if inside {
+            return p;
+        }
+        let mut best = vs[0];
+        let mut best_d = f64::INFINITY;
+        for k in 0..vs.len() {
+            let (a, b) = (vs[k], vs[(k + 1) % vs.len()]);
+            let e = b - a;
+            let len2 = e.length_squared();
+            let t = if len2 > 0.0 { (e.dot(p - a) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            let q = a + e * t;
+            let d = (q - p).length_squared();
+            if d < best_d {
+                best_d = d;
+                best = q;
+            }
+        }
+        best
+    }
+
     /// Area in square scene units.
     #[must_use]
     pub fn area(&self) -> f64 {

@@ -150,6 +150,7 @@ fn build_cluster(h: &mut Hierarchy, centroids: &[DVec3], start: usize, end: usiz
             (corner - center).length()
         })
         .fold(0.0, f64::max);
+    let normal = flat_normal(h, start, end, center, radius);
     let e = &mut h.elements[id as usize];
     e.child_start = child_start;
     e.n_children = kids.len() as u32;
@@ -157,5 +158,31 @@ fn build_cluster(h: &mut Hierarchy, centroids: &[DVec3], start: usize, end: usiz
     e.area = area;
     e.center = center;
     e.radius = radius;
+    e.normal = normal;
     id
+}
+
+/// Tolerance of [`flat_normal`]: how far a member's normal may turn (`1 − n·n₀`) and a vertex lie
+/// off the plane (relative to the cluster's radius).
+pub const FLAT_REL_TOL: f64 = 1e-9;
+
+/// The common front normal of the polygons `cluster_polygons[start..end]` when they all lie in one
+/// plane facing the same way (a wall cut into pieces), else zero: such a cluster has a plane, and
+/// nothing behind it exchanges light with it (see [`crate::formfactor::behind_surface`]).
+fn flat_normal(h: &Hierarchy, start: usize, end: usize, center: DVec3, radius: f64) -> DVec3 {
+    let members = &h.cluster_polygons[start..end];
+    let Some(&first) = members.first() else { return DVec3::ZERO };
+    let n0 = h.elements[first as usize].normal;
+    let tol = FLAT_REL_TOL * radius.max(f64::MIN_POSITIVE);
+    for &p in members {
+        let e = &h.elements[p as usize];
+        if 1.0 - e.normal.dot(n0) > FLAT_REL_TOL {
+            return DVec3::ZERO;
+        }
+        let Some(poly) = e.poly() else { return DVec3::ZERO };
+        if poly.vertices().iter().any(|v| n0.dot(*v - center).abs() > tol) {
+            return DVec3::ZERO;
+        }
+    }
+    n0
 }

@@ -52,7 +52,8 @@ pub struct Element {
     pub area: f64,
     /// Area centroid.
     pub center: DVec3,
-    /// Unit front normal (zero for clusters).
+    /// Unit front normal: a surface's; a cluster's when all its polygons lie in one plane facing
+    /// the same way, else zero.
     pub normal: DVec3,
     /// Bounding box.
     pub bounds: Aabb,

@@ -14,7 +14,7 @@
 //!
 //! The albedo comes from a [`PhaseMethod`]: a seeded random walk through the prototype (handles
 //! two-sided surfaces with transmittance exactly), or a local hierarchical radiosity solution of the
-//! prototype lit by a large distant emitter ([`crate::pipeline::run`] with [`crate::refine::BfHand`];
+//! prototype lit by a large distant emitter ([`crate::pipeline::run`] with [`crate::refine::ClassicBf`];
 //! one-sided and two-sided-as-pairs surfaces, no transmittance).
 
 use super::InstancingError;
@@ -22,7 +22,7 @@ use super::flatten::{FlattenOptions, flatten_prototype};
 use super::model::{InstancedScene, PrototypeId, Transform};
 use crate::geom::{Aabb, DVec3};
 use crate::pipeline;
-use crate::refine::{BfHand, BfParams};
+use crate::refine::{ClassicBf, first_guess_max};
 use crate::scene::{Material, Polygon, Scene};
 use crate::visibility::{RayCaster, Rng};
 use serde::{Deserialize, Serialize};
@@ -467,8 +467,16 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, _a_eff: f64, eps: f64
     if intercepted.is_nan() || intercepted <= 0.0 {
         return [0.0; 3];
     }
-    let oracle = BfHand { params: BfParams { eps } };
-    let solved = pipeline::run(&scene, &oracle, &pipeline::Config { estimate_error: false, ..pipeline::Config::default() }, &|_| {});
+    let oracle = ClassicBf { eps, b_ref: first_guess_max(&scene) };
+    let config = pipeline::Config {
+        estimate_error: false,
+        detect_closure: false,
+        levels: 1,
+        max_passes: 3,
+        measure_variation: false,
+        ..pipeline::Config::default()
+    };
+    let solved = pipeline::run(&scene, &oracle, &config, &|_| {});
     let h = &solved.hierarchy;
     let mut absorbed = [0.0; 3];
     for leaf in h.leaves() {

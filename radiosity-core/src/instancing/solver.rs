@@ -54,7 +54,7 @@ use super::properties::{CacheOutcome, PropertyCache, PropertyConfig, RadiativePr
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
 use crate::pipeline;
-use crate::refine::{BfHand, BfParams, Link};
+use crate::refine::{BfParams, ClassicBf, Link, first_guess_max};
 use crate::scene::{Material, SceneBuilder, shapes::box_faces};
 use crate::solve::Solution;
 use glam::{DMat3, DMat4};
@@ -1041,7 +1041,8 @@ fn build_level(
     }
     let mut pipeline_config = local_pipeline(config);
     pipeline_config.build.min_area_rel = min_area / local.total_area();
-    let solved = pipeline::run(&local, &BfHand { params: bf }, &pipeline_config, &|_| {});
+    let oracle = ClassicBf { eps: bf.eps, b_ref: first_guess_max(&local) };
+    let solved = pipeline::run(&local, &oracle, &pipeline_config, &|_| {});
     Ok(Some(Level {
         polys,
         roles,
@@ -1066,10 +1067,21 @@ struct OutsideLight<'a> {
     raise: f64,
 }
 
-/// Settings of every local solve.
+/// Refine → solve rounds of a local solve (the classic BF criterion reads the last solution's
+/// radiosity).
+const LOCAL_PASSES: usize = 3;
+
+/// Settings of every local solve (and of the full solve it is compared with): one level of the
+/// classic BF oracle ([`ClassicBf`]), no variation measured, no estimate, no closure (a local
+/// problem is open to the rest of the scene).
 fn local_pipeline(config: &InstancedConfig) -> pipeline::Config {
     pipeline::Config {
         estimate_error: false,
+        detect_closure: false,
+        levels: 1,
+        max_passes: LOCAL_PASSES,
+        measure_variation: false,
+        target_error: None,
         solve: config.local_solve,
         leaf_operator_max_entries: config.local_leaf_operator_max_entries,
         ..config.pipeline
@@ -1493,12 +1505,7 @@ pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(P
     // No error estimate: the comparison measures the error, and the instanced solve has none either.
     // On a worker of the pool, as the instanced solve runs (a like-for-like comparison).
     let solved = rayon::scope(|_| {
-        pipeline::run(
-            &flat,
-            &BfHand { params: config.bf },
-            &pipeline::Config { estimate_error: false, solve: config.local_solve, ..config.pipeline },
-            &|_| {},
-        )
+        pipeline::run(&flat, &ClassicBf { eps: config.bf.eps, b_ref: first_guess_max(&flat) }, &local_pipeline(config), &|_| {})
     });
     let mut means = PolygonMeans::default();
     let mut leaves = Vec::new();

@@ -36,8 +36,8 @@ fn class_of(c: VisibilityClass) -> ReferenceClass {
 #[must_use]
 pub fn visibility_study(solved: &Solved, visibility: VisibilityConfig, thresholds: &[f64]) -> Vec<StudyRow> {
     let h = &solved.hierarchy;
-    let radiosity = vec![[0.0; 3]; h.len()];
-    let services = Services { hierarchy: h, caster: Some(&solved.caster), visibility, radiosity: &radiosity, b_ref: 1.0, shafts: None };
+    let data = crate::refine::ElementData::first_guess(h);
+    let services = Services { hierarchy: h, caster: Some(&solved.caster), visibility, data: &data, threshold_scale: 1.0, shafts: None };
     // Classify each link once; a fresh context per classifier so none reuses another's rays.
     let classified: Vec<(f64, ReferenceClass, [ReferenceClass; 3])> = solved
         .links

@@ -50,9 +50,14 @@ pub struct Stats {
     pub passes: usize,
     /// Final relative residual of the linear system.
     pub residual: f64,
-    /// A-posteriori error estimate of the solution, relative to the largest leaf radiosity (see
+    /// Estimated largest error of a non-emitting polygon's mean radiosity (every channel),
+    /// relative to the largest non-emitting polygon mean (see
     /// [`crate::pipeline::Solved::error_estimate`]; null when not estimated).
     pub error_estimate: Option<f64>,
+    /// The target error the solve refined to (null when it refined to a fixed eps).
+    pub target_error: Option<f64>,
+    /// What each refinement level cost and gave, coarse to fine: error against run time.
+    pub levels: Vec<crate::pipeline::LevelReport>,
     /// Seconds per phase.
     pub time_s: StatsTimes,
     /// Peak resident memory of the process (bytes), when the platform reports it.
@@ -65,6 +70,19 @@ pub struct Stats {
     pub power_emitted: f64,
     /// Absorbed power Σ A·(1−ρ)·H (W, same channel mean).
     pub power_absorbed: f64,
+    /// Absorbed over emitted power (null when nothing emits): 1 in a closed scene.
+    pub power_balance: Option<f64>,
+    /// Sampled fraction of the light leaving the surfaces that escapes the scene (null when not
+    /// measured; see [`crate::visibility::escape_fraction`]).
+    pub escape_fraction: Option<f64>,
+    /// Whether the scene is closed (every surface's light lands on another): the solve then
+    /// delivers each surface's light whole.
+    pub closed: bool,
+    /// Whether refinement stopped at the memory budget.
+    pub memory_limited: bool,
+    /// What the solve could not do as asked, in words (memory budget reached, target error not
+    /// reached).
+    pub solve_warnings: Vec<String>,
     /// Input warnings (degenerate faces skipped, etc.).
     pub warnings: crate::scene::SceneWarnings,
 }
@@ -130,6 +148,8 @@ impl Stats {
             passes: solved.passes,
             residual: solved.solution.residual,
             error_estimate: solved.error_estimate,
+            target_error: None,
+            levels: solved.levels.clone(),
             time_s: StatsTimes {
                 load,
                 build: solved.timings.build,
@@ -144,6 +164,11 @@ impl Stats {
             radiosity_mean,
             power_emitted,
             power_absorbed,
+            power_balance: (power_emitted > 0.0).then(|| power_absorbed / power_emitted),
+            escape_fraction: solved.escape_fraction.is_finite().then_some(solved.escape_fraction),
+            closed: solved.closed,
+            memory_limited: solved.memory_limited,
+            solve_warnings: solved.warnings.clone(),
             warnings: scene.warnings.clone(),
         }
     }

@@ -1,12 +1,15 @@
-//! The classic BF refinement oracle (Hanrahan, Salzman & Aupperle 1991), written by hand as a plain
-//! function: the baseline generated oracles are compared against.
+//! The BF refinement oracle (after Hanrahan, Salzman & Aupperle 1991), written by hand as a plain
+//! function: the baseline generated oracles are compared against. Every threshold is relative to
+//! the receiver's own irradiance ([`LinkCtx::threshold`]).
 
 use super::{Decision, LinkCtx, Oracle};
+use crate::formfactor::FormFactorQuality;
+use crate::oracle::tools::{CLUSTER_ERROR_COEF, SOURCE_VARIATION_WEIGHT};
 
 /// Parameters of the BF oracle.
 #[derive(Clone, Copy, Debug)]
 pub struct BfParams {
-    /// Threshold on `B_S · F`, relative to the scene's largest emitted radiosity.
+    /// Threshold on each link's transfer and error terms, relative to the receiver's irradiance.
     pub eps: f64,
 }
 
@@ -33,32 +36,59 @@ impl Oracle for BfHand {
     }
 }
 
-/// The BF decision: drop pairs that cannot see each other's front; link when `B_S · F_max` (the
-/// largest point form factor over the receiver, estimated) is below
-/// `eps · B_ref`; otherwise subdivide the element [`emitter_first`] picks, or the other one when
-/// that cannot be subdivided, or link when neither can.
+/// The BF decision (the graph of [`crate::oracle::bf`], written out): drop pairs that cannot see
+/// each other's front; subdivide a cluster link whose elements are too near for the cluster
+/// approximation; link when `B_S · F_max` is within the threshold; otherwise subdivide while the
+/// cluster approximation's error exceeds it, then (the source) while the source-variation error
+/// does, then while the partial-visibility error does; link when none does.
 pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
     if !ctx.facing() {
         return Decision::Stop;
     }
-    let f = ctx.form_factor_max();
+    if ctx.clusters_too_near() {
+        return split(ctx);
+    }
+    let threshold = ctx.threshold(params.eps);
     let b = ctx.emitter_radiosity();
-    let (s, r) = (ctx.emitter_element(), ctx.receiver_element());
-    // The cluster estimate is conservative (distance shortened by the bounding radii, full
-    // projected area), so a link it accepts carries at most eps·B_ref whatever the clusters'
-    // distance: near clusters are refined only when they matter. Forcing every near cluster pair
-    // down to surfaces made compact geometry (foliage) quadratic in its polygon count.
-    if b * f <= params.eps * ctx.services.b_ref {
+    if b * ctx.form_factor_max() <= threshold {
         return Decision::Link;
     }
+    let (s, r) = (ctx.emitter_element(), ctx.receiver_element());
+    if s.is_cluster() || r.is_cluster() {
+        let d2 = (s.center - r.center).length_squared();
+        let ratio2 = if d2 > 0.0 { (s.radius + r.radius).powi(2) / d2 } else { f64::INFINITY };
+        if b * ctx.form_factor(FormFactorQuality::Precise) * CLUSTER_ERROR_COEF * ratio2 > threshold {
+            return split(ctx);
+        }
+    }
+    let dv = ctx.emitter_variation();
+    if dv > 0.0 && ctx.source_variation_weight() * dv * SOURCE_VARIATION_WEIGHT > threshold {
+        let h = ctx.hierarchy();
+        match (h.can_subdivide(ctx.emitter), h.can_subdivide(ctx.receiver)) {
+            (false, false) => return Decision::Link,
+            (true, _) => return Decision::SubdivideEmitter,
+            (false, true) => {}
+        }
+    }
+    let transfer = b * ctx.form_factor_max() * ctx.receiver_reflectance();
+    if 0.5 * transfer > threshold {
+        let v = ctx.visibility(ctx.services.visibility.rays);
+        if 2.0 * v * (1.0 - v) * transfer > threshold {
+            return split(ctx);
+        }
+    }
+    Decision::Link
+}
+
+/// Subdivides what can be: [`emitter_first`] picks between two that can; link when neither can.
+fn split(ctx: &LinkCtx<'_>) -> Decision {
     let h = ctx.hierarchy();
-    let (can_s, can_r) = (h.can_subdivide(ctx.emitter), h.can_subdivide(ctx.receiver));
-    match (can_s, can_r) {
+    match (h.can_subdivide(ctx.emitter), h.can_subdivide(ctx.receiver)) {
         (false, false) => Decision::Link,
         (true, false) => Decision::SubdivideEmitter,
         (false, true) => Decision::SubdivideReceiver,
         (true, true) => {
-            if emitter_first(s, r) {
+            if emitter_first(ctx.emitter_element(), ctx.receiver_element()) {
                 Decision::SubdivideEmitter
             } else {
                 Decision::SubdivideReceiver

@@ -12,10 +12,12 @@ pub struct Services<'a> {
     pub caster: Option<&'a RayCaster>,
     /// Visibility sampling.
     pub visibility: VisibilityConfig,
-    /// Current radiosity per element (W/m²), for energy criteria.
-    pub radiosity: &'a [[f64; 3]],
-    /// Reference radiosity that relative thresholds are measured against (the largest emission).
-    pub b_ref: f64,
+    /// What is known of each element (radiosity, its variation, the irradiance reference), for
+    /// energy criteria.
+    pub data: &'a super::ElementData,
+    /// Factor on every threshold of this pass ([`LinkCtx::threshold`]): the pipeline refines
+    /// coarse to fine, from a few times the oracle's eps down to it (or below, for a target error).
+    pub threshold_scale: f64,
     /// Shaft culling for visibility, when enabled: links are classified by their shafts first and
     /// rays are cast against the shaft's candidate occluders only.
     pub shafts: Option<ShaftServices<'a>>,
@@ -47,6 +49,9 @@ pub struct LinkData {
     pub form_factor_range: Option<(f64, f64)>,
     /// The centre-to-centre axis and the areas projected along it.
     pub axis: Option<LinkAxis>,
+    /// How strongly the emitter's radiosity variation shows at the receiver
+    /// ([`LinkCtx::source_variation_weight`]).
+    pub source_variation_weight: Option<f64>,
     /// A mark left by an oracle's command tool (studies, traces); the driver ignores it.
     pub mark: Option<u32>,
 }
@@ -67,6 +72,10 @@ pub struct LinkAxis {
 /// Mean fraction of a cluster's area seen from a random direction (isotropic clusters: a quarter,
 /// as for the surface of a convex body).
 pub const CLUSTER_PROJECTED_FRACTION: f64 = 0.25;
+
+/// Largest kernel spread in [`LinkCtx::source_variation_weight`] (a kernel that varies from 0 to
+/// twice its mean over the emitter).
+pub const MAX_SOURCE_KERNEL_VARIATION: f64 = 2.0;
 
 /// Clusters nearer than this many times the sum of the bounding radii (centre distance) are too
 /// near for the isotropic cluster approximation (the criterion of the BF oracle).
@@ -148,7 +157,7 @@ impl<'a> LinkCtx<'a> {
         let h = self.services.hierarchy;
         let f = match quality {
             FormFactorQuality::Estimate => formfactor::estimate(h, self.emitter, self.receiver),
-            FormFactorQuality::Precise => formfactor::link_form_factor(h, self.emitter, self.receiver, quality),
+            FormFactorQuality::Shape | FormFactorQuality::Precise => formfactor::link_form_factor(h, self.emitter, self.receiver, quality),
         };
         self.data.form_factor = Some((f, quality));
         f
@@ -267,6 +276,41 @@ impl<'a> LinkCtx<'a> {
         range
     }
 
+    /// How strongly an uneven radiosity over the emitter shows in the receiver's mean irradiance:
+    /// `F · κ`, the link's form factor times the spread `(max − min) / mean` of the point form
+    /// factor from the emitter's probe points (centre, corners pulled in by
+    /// [`formfactor::MAX_PROBE_PULL`]) to the receiver (at most [`MAX_SOURCE_KERNEL_VARIATION`]).
+    /// By reciprocity `κ` is how unevenly the receiver, as a whole, weights the emitter's surface:
+    /// near 0 for a far receiver, large for one touching the emitter. A radiosity varying by `ΔB`
+    /// over the emitter then changes the receiver's mean irradiance by at most about
+    /// `F · κ · ΔB / 4` (the covariance of kernel and radiosity). A cluster emitter, whose
+    /// members' weights are not probed, gets `κ = MAX_SOURCE_KERNEL_VARIATION` (memoised).
+    pub fn source_variation_weight(&mut self) -> f64 {
+        if let Some(w) = self.data.source_variation_weight {
+            return w;
+        }
+        let h = self.services.hierarchy;
+        let s = self.emitter_element();
+        let kappa = match s.poly() {
+            None => MAX_SOURCE_KERNEL_VARIATION,
+            Some(sp) => {
+                let (mut lo, mut hi, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
+                let vs = sp.vertices();
+                for x in std::iter::once(s.center).chain(vs.iter().map(|&v| v + formfactor::MAX_PROBE_PULL * (s.center - v))) {
+                    let f = formfactor::point_to_element(h, x, s.normal, self.receiver);
+                    lo = lo.min(f);
+                    hi = hi.max(f);
+                    sum += f;
+                }
+                let mean = sum / (vs.len() + 1) as f64;
+                if mean > 0.0 { ((hi - lo) / mean).min(MAX_SOURCE_KERNEL_VARIATION) } else { MAX_SOURCE_KERNEL_VARIATION }
+            }
+        };
+        let w = self.form_factor(FormFactorQuality::Precise) * kappa;
+        self.data.source_variation_weight = Some(w);
+        w
+    }
+
     /// The centre-to-centre axis and the projected areas along it (memoised).
     pub fn axis(&mut self) -> LinkAxis {
         if let Some(a) = self.data.axis {
@@ -287,8 +331,43 @@ impl<'a> LinkCtx<'a> {
     /// Largest channel of the emitter's current radiosity.
     #[must_use]
     pub fn emitter_radiosity(&self) -> f64 {
-        let b = self.services.radiosity[self.emitter as usize];
+        let b = self.services.data.radiosity[self.emitter as usize];
         b[0].max(b[1]).max(b[2])
+    }
+
+    /// How much the emitter's radiosity varies over it (largest channel of `max − min`, W/m²; see
+    /// [`super::ElementData::variation`]).
+    #[must_use]
+    pub fn emitter_variation(&self) -> f64 {
+        self.services.data.variation[self.emitter as usize]
+    }
+
+    /// The receiver's reflectance, largest channel (the area-weighted mean of a cluster's).
+    #[must_use]
+    pub fn receiver_reflectance(&self) -> f64 {
+        let h = self.services.hierarchy;
+        let rho = match self.receiver_element().polygon() {
+            Some(p) => h.reflectance[p as usize],
+            None => h.reflectance_of(self.receiver),
+        };
+        rho[0].max(rho[1]).max(rho[2])
+    }
+
+    /// The irradiance a relative threshold on this link is measured against: the receiver's own
+    /// (its dimmest leaf's), at least the scene's floor ([`super::ElementData::reference`]).
+    #[must_use]
+    pub fn receiver_irradiance(&self) -> f64 {
+        self.services.data.reference(self.receiver)
+    }
+
+    /// `eps` as an irradiance at the receiver: `eps` times the pass's scale times
+    /// [`LinkCtx::receiver_irradiance`]. An error below it changes the receiver's irradiance (and
+    /// radiosity) by less than that fraction, however dim the receiver is next to the brightest
+    /// source: the same eps means the same relative accuracy on every surface.
+    #[must_use]
+    #[inline]
+    pub fn threshold(&self, eps: f64) -> f64 {
+        eps * self.services.threshold_scale * self.receiver_irradiance()
     }
 
     /// Whether the two elements can exchange light at all, judged from the planes of surfaces:

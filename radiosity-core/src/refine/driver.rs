@@ -37,7 +37,31 @@ pub struct RefineStats {
     pub subdivided: u64,
     /// Links dropped by the oracle or for a zero form factor.
     pub dropped: u64,
+    /// Subdivisions refused because refinement reached its memory budget
+    /// ([`RefineLimits::max_bytes`]): those links were kept where they were.
+    pub refused_for_memory: u64,
 }
+
+/// Bounds on what one refinement may take.
+#[derive(Clone, Copy, Debug)]
+pub struct RefineLimits {
+    /// Memory the hierarchy, the links and the pending candidates may hold (bytes, estimated from
+    /// their counts): beyond it no link is subdivided any more, the remaining candidates are linked
+    /// where they are, and [`RefineStats::refused_for_memory`] counts them.
+    pub max_bytes: usize,
+}
+
+impl Default for RefineLimits {
+    fn default() -> Self {
+        RefineLimits { max_bytes: usize::MAX }
+    }
+}
+
+/// Bytes one element costs in refinement: the element, its slot in the children list, and its
+/// per-element data (radiosity, variation, irradiance reference, the solver's vectors).
+pub const BYTES_PER_ELEMENT: usize = size_of::<crate::hierarchy::Element>() + 4 + 24 + 8 + 8 + 96;
+/// Bytes one link costs: the link, and its entries in the solver's operators.
+pub const BYTES_PER_LINK: usize = size_of::<Link>() + 16 + 24;
 
 #[derive(Clone)]
 struct Candidate {
@@ -70,14 +94,17 @@ pub const EVALUATE_BATCH: usize = 16_384;
 type PendingSplit = (ElementId, ElementId, Decision, Option<Arc<[u32]>>, f64);
 
 enum Outcome {
-    Keep(Link, bool),
+    /// Keep the link: whether its form factor was computed now, and whether a subdivision was
+    /// refused for memory.
+    Keep(Link, bool, bool),
     Split(Decision, Option<Arc<[u32]>>, f64),
     Drop,
 }
 
 /// Refines `links` (or, when empty, the root self-link) with `oracle` until every candidate is linked
-/// or dropped. `radiosity` holds the current radiosity per element; it is extended for new elements
-/// (children inherit their parent's value). `progress` is called after each batch with
+/// or dropped. `data` holds what is known of each element; it is extended for new elements
+/// (children inherit from their parent, see [`super::ElementData::inherit`]); every threshold of
+/// the pass is scaled by `threshold_scale`. `progress` is called after each batch with
 /// (links so far, candidates pending).
 #[allow(clippy::too_many_arguments)]
 pub fn refine(
@@ -86,9 +113,10 @@ pub fn refine(
     visibility: VisibilityConfig,
     oracle: &dyn Oracle,
     links: Vec<Link>,
-    radiosity: &mut Vec<[f64; 3]>,
-    b_ref: f64,
+    data: &mut super::ElementData,
+    threshold_scale: f64,
     shafts: Option<super::ShaftServices<'_>>,
+    limits: RefineLimits,
     progress: &dyn Fn(u64, u64),
 ) -> (Vec<Link>, RefineStats) {
     let mut stats = RefineStats::default();
@@ -116,15 +144,18 @@ pub fn refine(
         // down (the top level of a forest: 137,000 links re-examined per pass).
         let mut splits: Vec<PendingSplit> = Vec::new();
         for batch in pending.chunks(EVALUATE_BATCH) {
+            let bytes = h.len() * BYTES_PER_ELEMENT + (out.len() + pending.len() + 4 * splits.len()) * BYTES_PER_LINK;
+            let full = bytes > limits.max_bytes;
             let outcomes: Vec<Outcome> = {
-                let services = Services { hierarchy: h, caster, visibility, radiosity, b_ref, shafts };
-                batch.par_iter().map(|c| evaluate(&services, oracle, c)).collect()
+                let services = Services { hierarchy: h, caster, visibility, data, threshold_scale, shafts };
+                batch.par_iter().map(|c| evaluate(&services, oracle, c, full)).collect()
             };
             for (c, outcome) in batch.iter().zip(outcomes) {
                 stats.oracle_calls += u64::from(c.source != c.receiver);
                 match outcome {
-                    Outcome::Keep(link, computed) => {
+                    Outcome::Keep(link, computed, refused) => {
                         stats.form_factors += u64::from(computed);
+                        stats.refused_for_memory += u64::from(refused);
                         if link.ff * link.vis > MIN_LINK_FORM_FACTOR || c.existing.is_some() {
                             out.push(link);
                         } else {
@@ -142,7 +173,7 @@ pub fn refine(
         drop(pending);
         let mut next = Vec::new();
         for s in splits {
-            split(h, radiosity, s, &mut next);
+            split(h, data, s, &mut next);
         }
         pending = next;
         progress(out.len() as u64, pending.len() as u64);
@@ -151,7 +182,7 @@ pub fn refine(
     (out, stats)
 }
 
-fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outcome {
+fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate, memory_full: bool) -> Outcome {
     let h = services.hierarchy;
     if c.source == c.receiver {
         // Self-links: a cluster interacts with itself through its children; a planar surface does not.
@@ -159,26 +190,24 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
     }
     let mut ctx = LinkCtx::new(services, c.source, c.receiver);
     ctx.parent_candidates.clone_from(&c.cands);
-    match oracle.decide(&mut ctx) {
-        Decision::Link => {
-            if let Some((ff, vis)) = c.existing {
-                return Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, false);
-            }
-            let ff = ctx.form_factor(FormFactorQuality::Precise);
-            let vis = if ff > 0.0 { ctx.visibility(services.visibility.rays) } else { 0.0 };
-            Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, true)
+    let keep = |ctx: &mut LinkCtx<'_>, refused: bool| {
+        if let Some((ff, vis)) = c.existing {
+            return Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, false, refused);
         }
+        let ff = ctx.form_factor(FormFactorQuality::Precise);
+        let vis = if ff > 0.0 { ctx.visibility(services.visibility.rays) } else { 0.0 };
+        Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, true, refused)
+    };
+    match oracle.decide(&mut ctx) {
+        Decision::Link => keep(&mut ctx, false),
         Decision::Stop => Outcome::Drop,
+        _ if memory_full => keep(&mut ctx, true),
         d @ (Decision::SubdivideEmitter | Decision::SubdivideReceiver | Decision::SubdivideBoth) => {
             // An oracle may ask for an impossible subdivision: fall back to what can be done.
             let can_s = h.can_subdivide(c.source);
             let can_r = h.can_subdivide(c.receiver);
             let d = match (d, can_s, can_r) {
-                (_, false, false) => {
-                    let ff = ctx.form_factor(FormFactorQuality::Precise);
-                    let vis = if ff > 0.0 { ctx.visibility(services.visibility.rays) } else { 0.0 };
-                    return Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, true);
-                }
+                (_, false, false) => return keep(&mut ctx, false),
                 (Decision::SubdivideEmitter, false, true) | (Decision::SubdivideBoth, false, true) => Decision::SubdivideReceiver,
                 (Decision::SubdivideReceiver, true, false) | (Decision::SubdivideBoth, true, false) => Decision::SubdivideEmitter,
                 (d, _, _) => d,
@@ -201,18 +230,14 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate) -> Outc
     }
 }
 
-/// Subdivides as decided (children inherit their parent's radiosity) and queues the children's
-/// links, which inherit the candidates and the diagonal they were culled for.
-fn split(h: &mut Hierarchy, radiosity: &mut Vec<[f64; 3]>, pending: PendingSplit, next: &mut Vec<Candidate>) {
+/// Subdivides as decided (children inherit from their parent, [`super::ElementData::inherit`]) and
+/// queues the children's links, which inherit the candidates and the diagonal they were culled for.
+fn split(h: &mut Hierarchy, data: &mut super::ElementData, pending: PendingSplit, next: &mut Vec<Candidate>) {
     let (source, receiver, d, cands, culled_diag) = pending;
     let mut children_of = |h: &mut Hierarchy, id: ElementId| -> Vec<ElementId> {
         if h.get(id).n_children == 0 {
             h.subdivide(id);
-            let b = radiosity[id as usize];
-            radiosity.resize(h.len(), [0.0; 3]);
-            for &k in h.children_of(id) {
-                radiosity[k as usize] = b;
-            }
+            data.inherit(h, id);
         }
         h.children_of(id).to_vec()
     };

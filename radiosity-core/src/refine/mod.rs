@@ -2,13 +2,17 @@
 //! subdivide; the driver applies the decisions, subdividing elements lazily, until every candidate
 //! is linked or dropped.
 
+mod bf_classic;
 mod bf_hand;
 mod context;
+mod data;
 mod driver;
 
-pub use bf_hand::{BfHand, BfParams, emitter_first};
+pub use bf_classic::{ClassicBf, first_guess_max};
+pub use bf_hand::{BfHand, BfParams, bf_decide, emitter_first};
 pub use context::{LinkCtx, LinkData, Services, ShaftServices};
-pub use driver::{Link, RefineStats, refine};
+pub use data::{CHILD_VARIATION_FRACTION, ElementData, IRRADIANCE_FLOOR_REL, amplification};
+pub use driver::{BYTES_PER_ELEMENT, BYTES_PER_LINK, Link, RefineLimits, RefineStats, refine};
 
 /// What an oracle decides for a link.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -4,19 +4,25 @@
 //! matrix-free by restarted GMRES, which handles stiff scenes (ρ near 1) in a few dozen products
 //! instead of the O(1/(1−ρ)) sweeps of Jacobi iteration.
 
+mod cut;
 mod direct;
 mod estimate;
 mod final_gather;
 mod gmres;
 mod leaf;
 mod operator;
+mod ranges;
 
+pub use cut::Cut;
 pub use direct::{direct_irradiance, direct_lower_bound, emitter_exchange};
-pub use estimate::{ESTIMATE_BUDGET, ESTIMATE_MAX_SAMPLES, error_estimate};
+pub use estimate::{
+    ESTIMATE_FLOOR, ESTIMATE_SAFETY, LevelHistory, NOISE_SIGMAS, ORDER_MAX, ORDER_MIN, richardson_estimate, visibility_noise,
+};
 pub use final_gather::final_gather;
 pub use gmres::{GmresResult, gmres};
-pub use leaf::{LEAF_OPERATOR_MAX_ENTRIES, LeafCoefficients, LeafOperator, leaf_operator_entries};
+pub use leaf::{LEAF_OPERATOR_ENTRY_BYTES, LEAF_OPERATOR_MAX_ENTRIES, LeafCoefficients, LeafOperator, leaf_operator_entries};
 pub use operator::Operator;
+pub use ranges::element_data;
 
 use crate::hierarchy::Hierarchy;
 use crate::refine::Link;
@@ -68,8 +74,8 @@ pub fn solve(h: &Hierarchy, links: &[Link], initial: &[[f64; 3]], config: &Solve
 /// element, usually the hierarchical solution).
 #[must_use]
 pub fn solve_leaf_operator(op: &LeafOperator<'_>, initial: &[[f64; 3]], config: &SolveConfig) -> Solution {
-    let rhs = op.hierarchical().emission();
-    let x0 = op.hierarchical().leaves_from_elements(initial);
+    let rhs = op.cut().emission();
+    let x0 = op.cut().from_elements(initial);
     let result = gmres(&|x: &[f64], y: &mut [f64]| op.apply_system(x, y), &rhs, x0, config);
     let (radiosity, irradiance) = op.expand(&result.x);
     Solution { radiosity, irradiance, iterations: result.iterations, residual: result.residual, converged: result.converged }

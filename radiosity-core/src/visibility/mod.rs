@@ -9,4 +9,7 @@ mod rays;
 pub mod shaft;
 
 pub(crate) use rays::BvhFrame;
-pub use rays::{KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, sampled_visibility};
+pub use rays::{
+    ESCAPE_SAMPLES, KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, escape_fraction,
+    sampled_visibility,
+};

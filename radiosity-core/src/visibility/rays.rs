@@ -5,6 +5,7 @@ use crate::hierarchy::Hierarchy;
 use crate::scene::Scene;
 use glam::Vec3A;
 use obvhs::{BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray, triangle::Triangle};
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Fraction of the segment length left out at each end, so that the endpoints' neighbours that touch
@@ -172,6 +173,12 @@ impl RayCaster {
     #[must_use]
     pub fn segment_clear(&self, a: DVec3, b: DVec3, skip_a: u32, skip_b: u32) -> bool {
         self.rays_cast.add(1);
+        self.segment_clear_uncounted(a, b, skip_a, skip_b)
+    }
+
+    /// [`RayCaster::segment_clear`] without counting the segment in [`RayCaster::rays_cast`].
+    #[must_use]
+    pub fn segment_clear_uncounted(&self, a: DVec3, b: DVec3, skip_a: u32, skip_b: u32) -> bool {
         if self.triangles.is_empty() {
             return true;
         }
@@ -214,6 +221,13 @@ impl RayCaster {
     #[must_use]
     pub fn ray_clear(&self, origin: DVec3, dir: DVec3) -> bool {
         self.rays_cast.add(1);
+        self.ray_clear_uncounted(origin, dir)
+    }
+
+    /// [`RayCaster::ray_clear`] without counting the ray in [`RayCaster::rays_cast`] (rays that
+    /// analyse the scene rather than compute visibility).
+    #[must_use]
+    pub fn ray_clear_uncounted(&self, origin: DVec3, dir: DVec3) -> bool {
         if self.triangles.is_empty() {
             return true;
         }
@@ -227,6 +241,46 @@ impl RayCaster {
     pub fn visibility(&self, h: &Hierarchy, source: u32, receiver: u32, config: &VisibilityConfig) -> f64 {
         sampled_visibility(h, source, receiver, config, |pa, pb, poly_a, poly_b| self.segment_clear(pa, pb, poly_a, poly_b))
     }
+}
+
+/// Rays [`escape_fraction`] casts.
+pub const ESCAPE_SAMPLES: u32 = 4096;
+/// How far from its surface (relative to the scene's diagonal) an escape ray starts, and how far a
+/// touching surface may be for the point to count as in contact.
+pub const ESCAPE_OFFSET_REL: f64 = 2e-4;
+
+/// The fraction of light leaving the scene's surfaces that escapes it: rays from points spread
+/// over every polygon's front side in proportion to its area, in cosine-distributed directions,
+/// that meet nothing ([`ESCAPE_SAMPLES`] rays, stratified, seeded). A point where another surface
+/// touches the polygon's front (a box standing on the floor) sends nothing. 0 for a closed scene
+/// (up to rays slipping through shared edges, a few in a million).
+#[must_use]
+pub fn escape_fraction(h: &Hierarchy, caster: &RayCaster, seed: u64) -> f64 {
+    let n = ESCAPE_SAMPLES;
+    // obvhs ignores hits nearer than 1e-4 of the frame (the scene's diagonal): the offset is twice
+    // that.
+    let offset = ESCAPE_OFFSET_REL * h.get(h.root).bounds.diagonal().max(f64::MIN_POSITIVE);
+    let escaped = (0..n)
+        .into_par_iter()
+        .filter(|&i| {
+            let mut rng = Rng::for_link(seed, i, u32::MAX);
+            let w = (f64::from(i) + rng.next_f64()) / f64::from(n);
+            let (p, poly) = h.sample_point(h.root, rng.next_f64(), rng.next_f64(), w);
+            let normal = h.get(poly).normal;
+            // Cosine-distributed direction about the normal.
+            let (u1, u2) = (rng.next_f64(), rng.next_f64());
+            let (r, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
+            let t = if normal.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+            let a = normal.cross(t).normalize();
+            let b = normal.cross(a);
+            let dir = a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt();
+            // A face in contact with another (a table leg's foot on the floor) sends nothing out:
+            // the ray would start beyond the surface it touches.
+            let in_contact = !caster.segment_clear_uncounted(p - normal * offset, p + normal * offset, poly, poly);
+            !in_contact && caster.ray_clear_uncounted(p + normal * offset, dir)
+        })
+        .count();
+    f64::from(escaped as u32) / f64::from(n)
 }
 
 /// Visibility between the surfaces of `source` and `receiver` from `config.rays` stratified

@@ -10,6 +10,9 @@ use crate::refine::LinkCtx;
 #[allow(missing_docs)]
 pub enum DynTool {
     BfAbove(BfAbove),
+    SourceVariation(SourceVariation),
+    PartialVisibility(PartialVisibility),
+    ClusterError(ClusterError),
     IrradianceChange(IrradianceChange),
     FfGradient(FfGradient),
     RayVisibility(RayVisibility),
@@ -35,6 +38,9 @@ macro_rules! on_tool {
     ($tool:expr, $t:ident => $e:expr) => {
         match $tool {
             DynTool::BfAbove($t) => $e,
+            DynTool::SourceVariation($t) => $e,
+            DynTool::PartialVisibility($t) => $e,
+            DynTool::ClusterError($t) => $e,
             DynTool::IrradianceChange($t) => $e,
             DynTool::FfGradient($t) => $e,
             DynTool::RayVisibility($t) => $e,
@@ -75,6 +81,9 @@ impl DynTool {
         let u = |i: usize| f(i) as u32;
         Some(match name {
             "BfAbove" => DynTool::BfAbove(BfAbove(f(0))),
+            "SourceVariation" => DynTool::SourceVariation(SourceVariation(f(0))),
+            "PartialVisibility" => DynTool::PartialVisibility(PartialVisibility(f(0))),
+            "ClusterError" => DynTool::ClusterError(ClusterError(f(0))),
             "IrradianceChange" => DynTool::IrradianceChange(IrradianceChange(f(0))),
             "FfGradient" => DynTool::FfGradient(FfGradient(f(0))),
             "RayVisibility" => DynTool::RayVisibility(RayVisibility(u(0))),
@@ -114,6 +123,7 @@ impl DynTool {
         let names: &'static [&'static str] = match name {
             "BfAbove" | "Facing" | "ClusterTooNear" | "PlanesIntersect" | "ProjectedAreaBelow" => YesNo::NAMES,
             "IrradianceChange" => Irradiance::NAMES,
+            "SourceVariation" | "PartialVisibility" | "ClusterError" => ErrorBound::NAMES,
             "FfGradient" | "ShaftFfError" => FfSpread::NAMES,
             "RayVisibility" => VisibilityClass::NAMES,
             "ReferenceVisibility" => ReferenceClass::NAMES,

@@ -8,7 +8,10 @@ mod shaft;
 mod visibility;
 
 pub use command::{Done, Mark, PreciseFormFactor, PreciseVisibility};
-pub use energy::{BfAbove, FfGradient, FfSpread, Irradiance, IrradianceChange};
+pub use energy::{
+    BfAbove, CLUSTER_ERROR_COEF, ClusterError, ErrorBound, FfGradient, FfSpread, Irradiance, IrradianceChange, PartialVisibility,
+    SOURCE_VARIATION_WEIGHT, SourceVariation,
+};
 pub use geometry::{
     CanSubdivide, ClusterTooNear, Cone, Facing, Larger, NormalCone, PlanesIntersect, ProjectedAreaBelow, Side, SplitFirst, Subdividable,
     YesNo,

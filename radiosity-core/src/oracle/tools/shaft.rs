@@ -42,7 +42,7 @@ impl Tool for ShaftClassify {
     }
 }
 
-/// Is `B_S · (F_max − F_min) > eps · B_ref`? `F_min` is the smallest point form factor over the
+/// Is `B_S · (F_max − F_min)` above `eps` times the receiver's irradiance ([`LinkCtx::threshold`])? `F_min` is the smallest point form factor over the
 /// receiver when the shaft is empty, and 0 when some candidate may occlude (a spread over the
 /// receiver, so the answer is [`FfSpread`], as [`super::FfGradient`]'s).
 #[derive(Clone, Copy, Debug)]
@@ -57,6 +57,6 @@ impl Tool for ShaftFfError {
             Some(ShaftClass::Visible) => ctx.form_factor_range().0.min(f_max),
             _ => 0.0,
         };
-        if ctx.emitter_radiosity() * (f_max - f_min) > self.0 * ctx.services.b_ref { FfSpread::Above } else { FfSpread::Below }
+        if ctx.emitter_radiosity() * (f_max - f_min) > ctx.threshold(self.0) { FfSpread::Above } else { FfSpread::Below }
     }
 }

@@ -1,0 +1,127 @@
+//! What refinement knows of each element: its radiosity, how much that radiosity varies over it,
+//! and the irradiance its accuracy is measured against. The first pass starts from a guess
+//! ([`ElementData::first_guess`]); every later pass reads the last solution
+//! ([`crate::solve::element_data`]).
+
+use crate::hierarchy::{ElementId, Hierarchy};
+
+/// A child's radiosity variation as a fraction of its parent's until a solve measures it (regular
+/// subdivision halves the element's size, and a smooth variation with it).
+pub const CHILD_VARIATION_FRACTION: f64 = 0.5;
+
+/// Thresholds are relative to a receiver's own irradiance, but never to less than this fraction of
+/// the scene's mean irradiance: a surface a thousand times dimmer than the average is refined for
+/// the accuracy of one a thousand times dimmer, not without end.
+pub const IRRADIANCE_FLOOR_REL: f64 = 1e-3;
+
+/// Per-element data the oracle's energy criteria read ([`crate::refine::Services::data`]).
+#[derive(Clone, Debug, Default)]
+pub struct ElementData {
+    /// Radiosity B per element (area mean), W/m².
+    pub radiosity: Vec<[f64; 3]>,
+    /// How much the radiosity varies over the element: the largest channel of `max − min` over
+    /// its surface (probe points of its leaves, see [`crate::solve::element_data`]), W/m².
+    pub variation: Vec<f64>,
+    /// The irradiance a link to the element is measured against: the element's mean irradiance
+    /// (largest channel of the area-weighted mean over its leaves), W/m².
+    pub irradiance: Vec<f64>,
+    /// The smallest irradiance a threshold is relative to: [`IRRADIANCE_FLOOR_REL`] times the
+    /// scene's area-weighted mean irradiance.
+    pub irradiance_floor: f64,
+    /// How many times the emitted light is reflected on average: the power leaving all surfaces
+    /// over the power emitted (`1/(1 − ρ̄)` in a closed scene of reflectance ρ̄, at least 1).
+    /// An error in one link's transfer is reflected as often, so thresholds are divided by it
+    /// ([`ElementData::reference`]): the same eps then bounds the same relative error of the
+    /// solution in a stiff enclosure as in a dim room.
+    pub amplification: f64,
+}
+
+/// Power leaving all surfaces over the power emitted, largest channel, for per-polygon radiosity
+/// and emission (at least 1; 1 for a dark scene).
+#[must_use]
+pub fn amplification(areas: impl Iterator<Item = (f64, [f64; 3], [f64; 3])>) -> f64 {
+    let (mut leaving, mut emitted) = ([0.0; 3], [0.0; 3]);
+    for (a, b, e) in areas {
+        for c in 0..3 {
+            leaving[c] += a * b[c];
+            emitted[c] += a * e[c];
+        }
+    }
+    (0..3).filter(|&c| emitted[c] > 0.0).map(|c| leaving[c] / emitted[c]).fold(1.0, f64::max)
+}
+
+impl ElementData {
+    /// The guess refinement starts from, before anything is solved: emission plus a uniform
+    /// ambient irradiance (the closed-scene estimate `Φ / (A (1 − ρ̄))`, reflected by each
+    /// polygon), no variation over any element (the first solve measures it), and that ambient
+    /// irradiance as every receiver's reference.
+    #[must_use]
+    pub fn first_guess(h: &Hierarchy) -> ElementData {
+        let n = h.n_polygons as usize;
+        let mut power = [0.0; 3];
+        let mut area = 0.0;
+        let mut rho_area = [0.0; 3];
+        for p in 0..n {
+            let a = h.get(p as u32).area;
+            area += a;
+            for c in 0..3 {
+                power[c] += a * h.emission[p][c];
+                rho_area[c] += a * h.reflectance[p][c];
+            }
+        }
+        let ambient: [f64; 3] =
+            std::array::from_fn(|c| if area > 0.0 { power[c] / area / (1.0 - rho_area[c] / area).max(1e-3) } else { 0.0 });
+        let mut b = vec![[0.0; 3]; h.len()];
+        for p in 0..n {
+            b[p] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * ambient[c]);
+        }
+        // Clusters: area-weighted means, children before parents. The build reserves a cluster's
+        // slot before building its children (pre-order), so every descendant of a cluster has a
+        // larger id: going down the ids reaches the children first.
+        for e in (n..h.len()).rev() {
+            let el = h.get(e as u32);
+            if el.is_cluster() {
+                let mut acc = [0.0; 3];
+                for &k in h.children_of(e as u32) {
+                    let a = h.get(k).area;
+                    for c in 0..3 {
+                        acc[c] += a * b[k as usize][c];
+                    }
+                }
+                b[e] = acc.map(|v| if el.area > 0.0 { v / el.area } else { 0.0 });
+            }
+        }
+        let h_ambient = ambient.iter().copied().fold(0.0, f64::max);
+        let amplification = amplification((0..n).map(|p| (h.get(p as u32).area, b[p], h.emission[p])));
+        ElementData {
+            radiosity: b,
+            variation: vec![0.0; h.len()],
+            irradiance: vec![h_ambient; h.len()],
+            irradiance_floor: IRRADIANCE_FLOOR_REL * h_ambient,
+            amplification,
+        }
+    }
+
+    /// Gives the new children of `parent` their parent's radiosity and irradiance reference and
+    /// [`CHILD_VARIATION_FRACTION`] of its variation (the arrays grow to `h.len()`).
+    pub fn inherit(&mut self, h: &Hierarchy, parent: ElementId) {
+        let n = h.len();
+        let (b, v, e) = (self.radiosity[parent as usize], self.variation[parent as usize], self.irradiance[parent as usize]);
+        self.radiosity.resize(n, [0.0; 3]);
+        self.variation.resize(n, 0.0);
+        self.irradiance.resize(n, 0.0);
+        for &k in h.children_of(parent) {
+            self.radiosity[k as usize] = b;
+            self.variation[k as usize] = CHILD_VARIATION_FRACTION * v;
+            self.irradiance[k as usize] = e;
+        }
+    }
+
+    /// The irradiance a threshold on links to `receiver` is relative to: its reference, at least
+    /// the floor, divided by the [`ElementData::amplification`].
+    #[must_use]
+    #[inline]
+    pub fn reference(&self, receiver: ElementId) -> f64 {
+        self.irradiance[receiver as usize].max(self.irradiance_floor) / self.amplification
+    }
+}

@@ -1,0 +1,153 @@
+//! What the next refinement pass reads of a solution ([`crate::refine::ElementData`]): each
+//! element's radiosity, how much it varies over the element, and its irradiance reference.
+//!
+//! The variation over a leaf is measured at probe points (its centre and its corners pulled a
+//! little toward it, as [`crate::formfactor::estimate_max`] probes): the irradiance there is
+//! gathered from every link on the leaf's chain with the point form factor, and turned into
+//! radiosity (`E + ρH + t·H̄`). A parent's range is the union of its children's. A source whose
+//! radiosity does not vary (a lamp of uniform exitance, a furnace wall) needs no subdivision however
+//! much light it sends: what the receiver gets from it is exact with the link's form factor.
+
+use super::Solution;
+use super::leaf::LinksByReceiver;
+use crate::formfactor::{MAX_PROBE_PULL, point_to_element};
+use crate::geom::DVec3;
+use crate::hierarchy::{ElementId, Hierarchy, NONE};
+use crate::refine::{ElementData, IRRADIANCE_FLOOR_REL, Link, amplification};
+use rayon::prelude::*;
+
+/// Sources farther from a leaf than this many times the sum of their bounding radii light it
+/// uniformly for the purpose of its radiosity range (their point form factor is evaluated once, at
+/// the leaf's centre).
+pub const PROBE_FAR_SEPARATION: f64 = 6.0;
+
+/// Sources at least this far from a leaf (and nearer than [`PROBE_FAR_SEPARATION`]) are seen
+/// from each probe as a point at their centre (the kernel times their area, within a few percent
+/// of Lambert's formula there, and no arc tangents).
+pub const PROBE_KERNEL_SEPARATION: f64 = 2.0;
+
+/// The point form factor from `x` (normal `n`) to surface element `source` seen as a point at its
+/// centre: `A cos θ_x cos θ_s / (π r²)`.
+fn point_kernel(h: &Hierarchy, x: DVec3, n: DVec3, source: ElementId) -> f64 {
+    let s = h.get(source);
+    let d = s.center - x;
+    let r2 = d.length_squared();
+    if r2 <= 0.0 {
+        return 0.0;
+    }
+    (s.area * n.dot(d).max(0.0) * (-s.normal.dot(d)).max(0.0) / (std::f64::consts::PI * r2 * r2)).min(1.0)
+}
+
+/// Radiosity ranges and irradiance references of every element of `h` for the solution `sol` of
+/// `links`.
+#[must_use]
+pub fn element_data(h: &Hierarchy, links: &[Link], sol: &Solution) -> ElementData {
+    let n = h.len();
+    let index = LinksByReceiver::new(h, links);
+    let leaves: Vec<ElementId> = h.leaves().collect();
+    let leaf_ranges: Vec<([f64; 3], [f64; 3])> = leaves.par_iter().map(|&leaf| leaf_range(h, &index, sol, leaf)).collect();
+    let mut lo = vec![[f64::INFINITY; 3]; n];
+    let mut hi = vec![[f64::NEG_INFINITY; 3]; n];
+    let mut irradiance = vec![f64::INFINITY; n];
+    let (mut h_sum, mut area) = (0.0, 0.0);
+    for (&leaf, &(l, u)) in leaves.iter().zip(&leaf_ranges) {
+        lo[leaf as usize] = l;
+        hi[leaf as usize] = u;
+        let hl = max3(sol.irradiance[leaf as usize]);
+        irradiance[leaf as usize] = hl;
+        let a = h.get(leaf).area;
+        h_sum += a * hl;
+        area += a;
+    }
+    // Parents from children: reverse breadth-first order visits children first.
+    let mut order = vec![h.root];
+    let mut i = 0;
+    while i < order.len() {
+        order.extend_from_slice(h.children_of(order[i]));
+        i += 1;
+    }
+    for &e in order.iter().rev() {
+        let kids = h.children_of(e);
+        if kids.is_empty() {
+            continue;
+        }
+        let mut mean = 0.0;
+        for &k in kids {
+            for c in 0..3 {
+                lo[e as usize][c] = lo[e as usize][c].min(lo[k as usize][c]);
+                hi[e as usize][c] = hi[e as usize][c].max(hi[k as usize][c]);
+            }
+            mean += h.get(k).area * irradiance[k as usize];
+        }
+        irradiance[e as usize] = mean / h.get(e).area.max(f64::MIN_POSITIVE);
+    }
+    let variation = lo.iter().zip(&hi).map(|(l, u)| (0..3).map(|c| u[c] - l[c]).fold(0.0, f64::max).max(0.0)).collect();
+    // Elements outside the tree (none in practice) read 0.
+    let irradiance = irradiance.into_iter().map(|x| if x.is_finite() { x } else { 0.0 }).collect();
+    let mean = if area > 0.0 { h_sum / area } else { 0.0 };
+    let amplification = amplification(leaves.iter().map(|&l| {
+        let e = h.get(l);
+        let p = e.polygon().expect("leaves are surfaces") as usize;
+        (e.area, sol.radiosity[l as usize], h.emission[p])
+    }));
+    ElementData { radiosity: sol.radiosity.clone(), variation, irradiance, irradiance_floor: IRRADIANCE_FLOOR_REL * mean, amplification }
+}
+
+fn max3(v: [f64; 3]) -> f64 {
+    v[0].max(v[1]).max(v[2])
+}
+
+/// The smallest and largest radiosity (per channel) over `leaf`: at its probe points and its mean.
+fn leaf_range(h: &Hierarchy, index: &LinksByReceiver<'_>, sol: &Solution, leaf: ElementId) -> ([f64; 3], [f64; 3]) {
+    let e = h.get(leaf);
+    let mean = sol.radiosity[leaf as usize];
+    let (mut lo, mut hi) = (mean, mean);
+    let (Some(poly), Some(p)) = (e.poly(), e.polygon()) else { return (lo, hi) };
+    let p = p as usize;
+    let (rho, em, t, twin) = (h.reflectance[p], h.emission[p], h.transmittance[p], h.twin[p]);
+    let through = if twin == NONE { [0.0; 3] } else { sol.irradiance[twin as usize] };
+    let mut probes = [DVec3::ZERO; 5];
+    probes[0] = e.center;
+    let vs = poly.vertices();
+    for (k, v) in vs.iter().enumerate() {
+        probes[k + 1] = *v + MAX_PROBE_PULL * (e.center - *v);
+    }
+    let probes = &probes[..vs.len() + 1];
+    // Far sources light the leaf nearly uniformly: their share, taken at the centre, is the same at
+    // every probe; near ones are evaluated at each.
+    let mut uniform = [0.0; 3];
+    let mut near: Vec<(ElementId, f64, bool)> = Vec::new();
+    let mut a = leaf;
+    while a != NONE {
+        for l in index.at(a) {
+            let s = h.get(l.source);
+            let b = sol.radiosity[l.source as usize];
+            let separation = (s.center - e.center).length() / (s.radius + e.radius).max(f64::MIN_POSITIVE);
+            if separation >= PROBE_FAR_SEPARATION {
+                let f = point_to_element(h, e.center, e.normal, l.source) * l.vis;
+                for c in 0..3 {
+                    uniform[c] += f * b[c];
+                }
+            } else {
+                near.push((l.source, l.vis, separation >= PROBE_KERNEL_SEPARATION && s.poly().is_some()));
+            }
+        }
+        a = h.get(a).parent;
+    }
+    for &x in probes {
+        let mut hx = uniform;
+        for &(source, vis, kernel) in &near {
+            let f = if kernel { point_kernel(h, x, e.normal, source) } else { point_to_element(h, x, e.normal, source) } * vis;
+            let b = sol.radiosity[source as usize];
+            for c in 0..3 {
+                hx[c] += f * b[c];
+            }
+        }
+        for c in 0..3 {
+            let bx = em[c] + rho[c] * hx[c] + t[c] * through[c];
+            lo[c] = lo[c].min(bx);
+            hi[c] = hi[c].max(bx);
+        }
+    }
+    (lo, hi)
+}
