@@ -105,6 +105,25 @@ fn errors_are_collected_not_just_the_first() {
 }
 
 #[test]
+fn fallback_expansion_of_an_invalid_graph() {
+    // The error next to everything user code calls: params, type, constructors, `GRAPH`, `Oracle`.
+    check_expansion(
+        "fallback",
+        r#"
+            crate = ::radiosity;
+
+            /// BF with a node that forgets two answers.
+            pub oracle Partial {
+                params { eps: f64 = 0.01 in 0.0..=1.0, min_area: f64 = 0.0 }
+                start => energy;
+                energy: BfAbove(eps) { No => link, Yes => size }
+                size: CanSubdivide(min_area) { Neither => link, Both => subdivide_both }
+            }
+        "#,
+    );
+}
+
+#[test]
 fn bf_graph_dot() {
     use radiosity::oracle::bf::BfFlat;
     insta::assert_snapshot!("bf_dot", oracle_graph::to_dot(&BfFlat::<radiosity::oracle::NoProbe>::GRAPH, None));

@@ -9,7 +9,8 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 /// Expands the input of `oracle! { ... }`. Errors become `compile_error!`s at the offending
-/// tokens, next to a stub of each failing oracle.
+/// tokens, next to the fallback of each failing oracle (its type, params struct and constructors,
+/// see [`expand::expand_fallback`]), so user code calling them gets no second wave of errors.
 #[must_use]
 pub fn expand(input: TokenStream) -> TokenStream {
     let input: parse::Input = match syn::parse2(input) {
@@ -27,7 +28,7 @@ pub fn expand(input: TokenStream) -> TokenStream {
         if m.checked.is_some() {
             out.extend(expand::expand_oracle(&k, m));
         } else {
-            out.extend(expand::expand_stub(&k, m.decl));
+            out.extend(expand::expand_fallback(&k, m));
         }
     }
     if let Some(e) = errors.take() {
