@@ -175,7 +175,11 @@ fn node_body(k: &TokenStream, m: &OracleModel<'_>, i: usize) -> TokenStream {
     let info = checked.tools[i];
     let tool_path = tool_path(k, m, i);
     let args: Vec<TokenStream> = node.args.iter().enumerate().map(|(a, arg)| arg_code(m, info.map(|t| t.args[a].ty), arg)).collect();
-    let tool_expr = if node.args.is_empty() { tool_path.clone() } else { quote!(#tool_path(#(#args),*)) };
+    // The tool's path is named once, in the type namespace, so an unknown tool is one error: a
+    // tool without arguments is built through the alias (`Alias {}` builds a unit struct too); one
+    // with arguments by its tuple constructor, which names the path again in the value namespace.
+    let tool_alias = format_ident!("__OracleTool_{}", node.name);
+    let tool_expr = if node.args.is_empty() { quote!(#tool_alias {}) } else { quote!(#tool_path(#(#args),*)) };
     let alias = format_ident!("__OracleAnswer_{}", node.name);
     let arms: Vec<TokenStream> = node
         .arms
@@ -194,7 +198,8 @@ fn node_body(k: &TokenStream, m: &OracleModel<'_>, i: usize) -> TokenStream {
         }
     };
     quote! {{
-        type #alias = <#tool_path as #k::oracle::Tool>::Answer;
+        type #tool_alias = #tool_path;
+        type #alias = <#tool_alias as #k::oracle::Tool>::Answer;
         let __oracle_tool = #tool_expr;
         let __oracle_t0 = <P as #k::oracle::Probe>::start();
         let __oracle_answer = #k::oracle::Tool::ask(&__oracle_tool, ctx);
