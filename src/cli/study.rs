@@ -102,7 +102,7 @@ fn print_table(name: &str, args: &StudyArgs, n_links: usize, rows: &[StudyRow], 
     for (r, rel) in rows.iter().zip(thresholds_rel) {
         let rate = |k: usize| {
             let wrong = (r.error_rate[k] * r.links as f64).round();
-            if r.links == 0 { "–".to_string() } else { format!("{:.2}% ({wrong})", 100.0 * r.error_rate[k]) }
+            if r.links == 0 { "–".to_string() } else { format!("{} ({wrong})", percent(r.error_rate[k])) }
         };
         println!("| {} | {} | {} | {} | {} |", radiosity::oracle::graph::format_number(*rel), r.links, rate(0), rate(1), rate(2));
     }
@@ -111,4 +111,26 @@ fn print_table(name: &str, args: &StudyArgs, n_links: usize, rows: &[StudyRow], 
         "(error: share of the links below the threshold that the rays put in another class than the reference does, and \
          their number; solve {solve_s:.2}s, study {study_s:.2}s)"
     );
+}
+
+/// A share as a percentage with two decimals, or two significant digits when smaller (a share of
+/// 1 link in 42,424 is `0.0024%`, not `0.00%`).
+fn percent(share: f64) -> String {
+    let p = 100.0 * share;
+    let decimals = if p > 0.0 && p < 0.1 { (1.0 - p.log10().floor()) as usize } else { 2 };
+    format!("{p:.decimals$}%")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::percent;
+
+    #[test]
+    fn small_shares_keep_two_significant_digits() {
+        assert_eq!(percent(0.1325102880658436), "13.25%");
+        assert_eq!(percent(0.0), "0.00%");
+        assert_eq!(percent(16.0 / 47291.0), "0.034%");
+        assert_eq!(percent(1.0 / 42424.0), "0.0024%");
+        assert_eq!(percent(1.0), "100.00%");
+    }
 }
