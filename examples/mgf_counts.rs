@@ -63,7 +63,8 @@ fn main() {
             }
             Err(e) => {
                 failed = true;
-                println!("| {} | ERROR: {e} |", row.file);
+                // `{:#}` prints the chain of causes (an unreadable file's reason is its source).
+                println!("| {} | ERROR: {:#} |", row.file, anyhow::Error::from(e));
             }
         }
     }
@@ -89,7 +90,7 @@ fn main() {
             }
             Err(e) => {
                 failed = true;
-                println!("| {file} | ERROR: {e} |");
+                println!("| {file} | ERROR: {:#} |", anyhow::Error::from(e));
             }
         }
     }

@@ -105,6 +105,56 @@ fn errors_are_collected_not_just_the_first() {
 }
 
 #[test]
+fn fallback_expansion_of_an_invalid_graph() {
+    // The error next to everything user code calls: params, type, constructors, `GRAPH`, `Oracle`.
+    check_expansion(
+        "fallback",
+        r#"
+            crate = ::radiosity;
+
+            /// BF with a node that forgets two answers.
+            pub oracle Partial {
+                params { eps: f64 = 0.01 in 0.0..=1.0, min_area: f64 = 0.0 }
+                start => energy;
+                energy: BfAbove(eps) { No => link, Yes => size }
+                size: CanSubdivide(min_area) { Neither => link, Both => subdivide_both }
+            }
+        "#,
+    );
+}
+
+#[test]
+fn a_syntax_error_still_gives_the_oracles_it_can_find() {
+    let out = expand_str(
+        r#"
+        crate = ::radiosity;
+        pub(crate) oracle First {
+            params { eps: f64 = 0.01 in 0.0..=1.0, rays: u32 = 4 }
+            start => a;
+            a: Facing { Yes => link No => stop }
+        }
+        oracle Second { start => a; a: Facing { Yes => link, No => stop } }
+        "#,
+    );
+    let file: syn::File = syn::parse2(out.clone()).unwrap_or_else(|e| panic!("fallback does not parse: {e}\n{out}"));
+    let text = prettyplease::unparse(&file);
+    assert_eq!(text.matches("compile_error!").count(), 1, "only the syntax error is reported:\n{text}");
+    assert!(text.contains("expected `,`"), "{text}");
+    for needle in [
+        "pub(crate) struct FirstParams {",
+        "pub eps: f64,",
+        "pub rays: u32,",
+        "pub(crate) struct First<P = ::radiosity::oracle::NoProbe>",
+        "struct SecondParams {}",
+        "struct Second<P = ::radiosity::oracle::NoProbe>",
+        "pub fn new(params: SecondParams) -> Self",
+        "pub fn with_probe(params: FirstParams, probe: P) -> Self",
+    ] {
+        assert!(text.contains(needle), "missing {needle:?} in\n{text}");
+    }
+}
+
+#[test]
 fn bf_graph_dot() {
     use radiosity::oracle::bf::BfFlat;
     insta::assert_snapshot!("bf_dot", oracle_graph::to_dot(&BfFlat::<radiosity::oracle::NoProbe>::GRAPH, None));

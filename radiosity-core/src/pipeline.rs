@@ -311,7 +311,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let mut iterations = 0;
     let mut levels = Vec::new();
     let mut leaf_entries = 0;
-    let n_levels = if config.target_error.is_some() { config.max_levels.max(1) } else { config.levels.max(1) };
+    // A target error needs the estimate (and the leaf-resolution solve it is made with).
+    let target_error = config.target_error.filter(|_| config.estimate_error && config.final_gather);
+    let n_levels = if target_error.is_some() { config.max_levels.max(1) } else { config.levels.max(1) };
     // Without a target the last level is at the oracle's eps; with one, the levels run on from the
     // same first level until the estimate is below the target.
     let first_scale = config.level_step.powi(config.levels.max(1) as i32 - 1);
@@ -369,7 +371,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let means: Vec<[f64; 3]> = crate::output::polygon_results(&h, &sol).into_iter().map(|r| r.b).collect();
         let change = history.push(means);
         let last = level + 1 == n_levels || stats.refused_for_memory > 0;
-        let estimate = (config.estimate_error && entries > 0 && (config.target_error.is_some() || last))
+        let estimate = (config.estimate_error && entries > 0 && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, config));
         let report = LevelReport {
             threshold_scale: scale,
@@ -383,11 +385,14 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         progress(Progress::Level { level: level + 1, report });
         levels.push(report);
         solution = Some(sol);
-        let reached = match (config.target_error, estimate) {
+        let reached = match (target_error, estimate) {
             (Some(target), Some(e)) => e <= target,
             _ => false,
         };
-        if reached || stats.refused_for_memory > 0 {
+        // Without an estimate (the leaf-resolution operator over its budget) a target cannot be
+        // checked: stop at this level.
+        let unestimated = target_error.is_some() && estimate.is_none();
+        if reached || unestimated || stats.refused_for_memory > 0 {
             break;
         }
     }
@@ -401,10 +406,14 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             stats.refused_for_memory
         ));
     }
-    if let (Some(target), Some(e)) = (config.target_error, error_estimate)
-        && e > target
-    {
-        warnings.push(format!("target error {target} not reached: estimate {e:.3e} after {} levels", levels.len()));
+    match (target_error, error_estimate) {
+        (Some(target), Some(e)) if e > target => {
+            warnings.push(format!("target error {target} not reached: estimate {e:.3e} after {} levels", levels.len()))
+        }
+        (Some(target), None) => warnings.push(format!(
+            "target error {target} not checked: the leaf-resolution solve, which the estimate needs, is over its budget"
+        )),
+        _ => {}
     }
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];

@@ -6,6 +6,7 @@ mod generate;
 mod oracle;
 mod progress;
 mod solve;
+mod study;
 mod sweep;
 
 use anyhow::Context;
@@ -33,7 +34,8 @@ enum Command {
         #[command(subcommand)]
         which: generate::GenerateCommand,
     },
-    /// Refinement oracles: list them, export their graphs, trace their decisions.
+    /// Refinement oracles: list them, export their graphs, trace their decisions, study their
+    /// visibility classification.
     Oracle {
         #[command(subcommand)]
         which: oracle::OracleCommand,

@@ -1,4 +1,5 @@
-//! `radiosity oracle {list,dot,explain}`: the named refinement oracles and their decision graphs.
+//! `radiosity oracle {list,dot,explain,study}`: the named refinement oracles, their decision graphs,
+//! and the visibility study behind their visibility nodes.
 
 use super::{CommonOptions, load_scene};
 use radiosity::oracle::{self, registry};
@@ -33,6 +34,9 @@ pub enum OracleCommand {
         #[command(flatten)]
         options: CommonOptions,
     },
+    /// The visibility study: for the links of a BF solve whose projected areas lie below each
+    /// threshold, the share that 4, 16 and 64 rays classify differently from the reference.
+    Study(super::study::StudyArgs),
 }
 
 /// Parses `--param name=value` arguments.
@@ -67,5 +71,6 @@ pub fn run(cmd: OracleCommand) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        OracleCommand::Study(args) => super::study::run(&args),
     }
 }

@@ -100,6 +100,9 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let auto = radiosity::instancing::auto_instance(&scene, &radiosity::instancing::AutoOptions::default());
         if !args.quiet {
+            if let Some(w) = scene.warnings.summary() {
+                eprintln!("warning: {w}");
+            }
             println!("{} in {:.3}s", auto.report, t0.elapsed().as_secs_f64());
         }
         return solve_instanced(args, &auto.scene, Some(&auto.report));
@@ -160,12 +163,8 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
 }
 
 fn print_summary(s: &Stats, out: &std::path::Path) {
-    let w = &s.warnings;
-    if w.degenerate_faces + w.triangulated_faces + w.clamped_materials > 0 {
-        eprintln!(
-            "warning: {} degenerate faces skipped, {} faces triangulated, {} materials clamped",
-            w.degenerate_faces, w.triangulated_faces, w.clamped_materials
-        );
+    if let Some(w) = s.warnings.summary() {
+        eprintln!("warning: {w}");
     }
     let balance = if s.power_emitted > 0.0 { s.power_absorbed / s.power_emitted } else { f64::NAN };
     println!(

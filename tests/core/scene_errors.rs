@@ -27,6 +27,10 @@ fn load_err(path: &Path, allow_dark: bool) -> String {
 fn missing_file_names_the_file() {
     let msg = load_err(Path::new("/nonexistent/room.obj"), false);
     assert!(msg.contains("/nonexistent/room.obj") && msg.contains("cannot read"), "{msg}");
+    // The operating system's reason is the source, so a chain of causes prints it once.
+    let err = load(Path::new("/nonexistent/room.obj"), &LoadOptions::default()).expect_err("no such file");
+    let source = std::error::Error::source(&err).expect("the reason is the source");
+    assert!(!msg.contains(&source.to_string()), "the message repeats its source: {msg}");
 }
 
 #[test]

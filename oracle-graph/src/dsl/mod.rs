@@ -9,12 +9,14 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 /// Expands the input of `oracle! { ... }`. Errors become `compile_error!`s at the offending
-/// tokens, next to a stub of each failing oracle.
+/// tokens, next to the fallback of each failing oracle (its type, params struct and constructors,
+/// see [`expand::expand_fallback`]), so user code calling them gets no second wave of errors. Input
+/// that does not parse gets the fallback of each oracle [`parse::recover`] finds in it.
 #[must_use]
 pub fn expand(input: TokenStream) -> TokenStream {
-    let input: parse::Input = match syn::parse2(input) {
-        Ok(i) => i,
-        Err(e) => return e.to_compile_error(),
+    let (input, syntax_error) = match syn::parse2::<parse::Input>(input.clone()) {
+        Ok(i) => (i, None),
+        Err(e) => (parse::recover(input), Some(e)),
     };
     let k = match &input.krate {
         Some(p) => quote!(#p),
@@ -24,13 +26,14 @@ pub fn expand(input: TokenStream) -> TokenStream {
     let models = check::check(&input, &mut errors);
     let mut out = TokenStream::new();
     for m in &models {
-        if m.checked.is_some() {
+        if m.checked.is_some() && syntax_error.is_none() {
             out.extend(expand::expand_oracle(&k, m));
         } else {
-            out.extend(expand::expand_stub(&k, m.decl));
+            out.extend(expand::expand_fallback(&k, m));
         }
     }
-    if let Some(e) = errors.take() {
+    // After a syntax error the recovered oracles have no nodes: their check errors are not the user's.
+    if let Some(e) = syntax_error.or_else(|| errors.take()) {
         out.extend(e.to_compile_error());
     }
     out

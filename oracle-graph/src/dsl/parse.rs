@@ -9,9 +9,9 @@
 //! node    := ident ":" path ("(" arg,* ")")? "{" (ident ("|" ident)* "=>" ident),* "}"
 //! ```
 
-use proc_macro2::{Span, TokenStream};
+use proc_macro2::{Delimiter, Span, TokenStream, TokenTree};
 use quote::ToTokens;
-use syn::parse::{Parse, ParseStream};
+use syn::parse::{Parse, ParseStream, Parser};
 use syn::punctuated::Punctuated;
 use syn::{Attribute, ExprClosure, Ident, Path, Token, Visibility, braced, parenthesized};
 
@@ -311,4 +311,66 @@ impl ArgDecl {
 #[must_use]
 pub fn path_name(path: &Path) -> String {
     path.to_token_stream().to_string().replace(' ', "")
+}
+
+/// What can be recovered from input that does not parse: the `crate = path;` prefix and each
+/// top-level `vis oracle Name { ... }` with its parameters (when its `params { ... }` block
+/// parses) and no nodes. The macro emits the fallback of each next to the syntax error, so that
+/// error is the only one the user sees.
+#[must_use]
+pub fn recover(input: TokenStream) -> Input {
+    let krate = (|s: ParseStream<'_>| {
+        let krate = if s.peek(Token![crate]) && s.peek2(Token![=]) {
+            s.parse::<Token![crate]>()?;
+            s.parse::<Token![=]>()?;
+            let path = Path::parse_mod_style(s)?;
+            s.parse::<Token![;]>()?;
+            Some(path)
+        } else {
+            None
+        };
+        s.parse::<TokenStream>()?;
+        Ok(krate)
+    })
+    .parse2(input.clone())
+    .ok()
+    .flatten();
+    let tokens: Vec<TokenTree> = input.into_iter().collect();
+    let is_word = |t: &TokenTree, word: &str| matches!(t, TokenTree::Ident(i) if i == word);
+    let mut items = Vec::new();
+    for (i, window) in tokens.windows(3).enumerate() {
+        let [TokenTree::Ident(keyword), TokenTree::Ident(name), TokenTree::Group(body)] = window else { continue };
+        if keyword != "oracle" || body.delimiter() != Delimiter::Brace {
+            continue;
+        }
+        // `pub` or `pub(...)` just before `oracle`.
+        let vis_len = match &tokens[..i] {
+            [.., word, TokenTree::Group(g)] if is_word(word, "pub") && g.delimiter() == Delimiter::Parenthesis => 2,
+            [.., word] if is_word(word, "pub") => 1,
+            _ => 0,
+        };
+        let vis = syn::parse2::<Visibility>(tokens[i - vis_len..i].iter().cloned().collect()).unwrap_or(Visibility::Inherited);
+        let body: Vec<TokenTree> = body.stream().into_iter().collect();
+        let params = body
+            .windows(2)
+            .find_map(|w| match w {
+                [word, TokenTree::Group(g)] if is_word(word, "params") && g.delimiter() == Delimiter::Brace => {
+                    Punctuated::<ParamDecl, Token![,]>::parse_terminated.parse2(g.stream()).ok()
+                }
+                _ => None,
+            })
+            .map(|list| list.into_iter().collect())
+            .unwrap_or_default();
+        items.push(Item::Oracle(OracleDecl {
+            attrs: Vec::new(),
+            vis,
+            keyword: kw::oracle(keyword.span()),
+            name: name.clone(),
+            params,
+            uses: Vec::new(),
+            starts: Vec::new(),
+            nodes: Vec::new(),
+        }));
+    }
+    Input { krate, items }
 }

@@ -1,4 +1,6 @@
 //! Errors of the instancing step: every message names the file, the line when known, and the reason.
+//! A reason that is itself an error (the operating system's, a prototype file's) is the error's
+//! `source`, not part of its message, so a front end printing the chain of causes prints it once.
 
 use crate::scene::SceneError;
 use std::path::PathBuf;
@@ -6,8 +8,8 @@ use std::path::PathBuf;
 /// A scene file with instances that cannot be loaded, written, or solved.
 #[derive(Debug, thiserror::Error)]
 pub enum InstancingError {
-    /// A file could not be read or written.
-    #[error("{}: {what}: {source}", path.display())]
+    /// A file could not be read or written (the reason is the source).
+    #[error("{}: {what}", path.display())]
     Io {
         /// File that failed.
         path: PathBuf,
@@ -26,8 +28,8 @@ pub enum InstancingError {
         /// What is wrong.
         msg: String,
     },
-    /// A prototype's OBJ file is invalid (the inner error names its file and line).
-    #[error("{}:{line}: prototype `{prototype}`: {source}", path.display())]
+    /// A prototype's OBJ file is invalid (the source names its file, line and reason).
+    #[error("{}:{line}: prototype `{prototype}`", path.display())]
     Prototype {
         /// Scene file naming the prototype.
         path: PathBuf,

@@ -7,6 +7,7 @@ use super::tools::{RayVisibility, ReferenceClass, ReferenceVisibility, Visibilit
 use crate::pipeline::Solved;
 use crate::refine::{LinkCtx, Services};
 use crate::visibility::VisibilityConfig;
+use rayon::prelude::*;
 
 /// Ray counts of the classifiers compared with the reference.
 pub const STUDY_RAYS: [u32; 3] = [4, 16, 64];
@@ -38,10 +39,11 @@ pub fn visibility_study(solved: &Solved, visibility: VisibilityConfig, threshold
     let h = &solved.hierarchy;
     let data = crate::refine::ElementData::first_guess(h);
     let services = Services { hierarchy: h, caster: Some(&solved.caster), visibility, data: &data, threshold_scale: 1.0, shafts: None };
-    // Classify each link once; a fresh context per classifier so none reuses another's rays.
+    // Classify each link once; a fresh context per classifier so none reuses another's rays. Links
+    // in parallel: each link's rays are seeded by the link, so the result does not depend on threads.
     let classified: Vec<(f64, ReferenceClass, [ReferenceClass; 3])> = solved
         .links
-        .iter()
+        .par_iter()
         .map(|l| {
             let mut ctx = LinkCtx::new(&services, l.source, l.receiver);
             let axis = ctx.axis();

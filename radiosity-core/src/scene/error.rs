@@ -1,12 +1,14 @@
 //! Errors of the scene step: every message names the file, the place (line or face) and the reason.
+//! A reason that is itself an error (the operating system's) is the error's `source`, not part of
+//! its message, so a front end printing the chain of causes prints it once.
 
 use std::path::PathBuf;
 
 /// A scene that cannot be loaded or is not valid input for a solve.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The file could not be read.
-    #[error("{}: cannot read file: {source}", path.display())]
+    /// The file could not be read (the reason is the source).
+    #[error("{}: cannot read file", path.display())]
     Io {
         /// File that failed.
         path: PathBuf,

@@ -96,6 +96,24 @@ pub struct SceneWarnings {
     pub messages: Vec<String>,
 }
 
+impl SceneWarnings {
+    /// What was repaired or skipped, in words, the counts that are zero left out
+    /// (`2 degenerate faces skipped, 1 face triangulated`); `None` when nothing was.
+    #[must_use]
+    pub fn summary(&self) -> Option<String> {
+        let parts: Vec<String> = [
+            (self.degenerate_faces, "degenerate face", "skipped"),
+            (self.triangulated_faces, "face", "triangulated"),
+            (self.clamped_materials, "material", "clamped"),
+        ]
+        .into_iter()
+        .filter(|&(n, ..)| n > 0)
+        .map(|(n, noun, done)| format!("{n} {noun}{} {done}", if n == 1 { "" } else { "s" }))
+        .collect();
+        (!parts.is_empty()).then(|| parts.join(", "))
+    }
+}
+
 /// A validated scene: planar, non-degenerate triangles and quads with finite coordinates.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -198,5 +216,23 @@ impl Scene {
             }
             c.position = pos;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SceneWarnings;
+
+    fn summary(degenerate_faces: usize, triangulated_faces: usize, clamped_materials: usize) -> Option<String> {
+        SceneWarnings { degenerate_faces, triangulated_faces, clamped_materials, messages: Vec::new() }.summary()
+    }
+
+    #[test]
+    fn warning_summary_says_only_what_happened_in_singular_or_plural() {
+        assert_eq!(summary(0, 0, 0), None);
+        assert_eq!(summary(0, 1, 0).as_deref(), Some("1 face triangulated"));
+        assert_eq!(summary(2, 0, 0).as_deref(), Some("2 degenerate faces skipped"));
+        assert_eq!(summary(1, 3, 1).as_deref(), Some("1 degenerate face skipped, 3 faces triangulated, 1 material clamped"));
+        assert_eq!(summary(0, 0, 2).as_deref(), Some("2 materials clamped"));
     }
 }
