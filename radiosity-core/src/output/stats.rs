@@ -21,6 +21,9 @@ pub struct StatsTimes {
     /// Solves timed: build, refine and solve are the fastest of them (1 unless `solve --time-for`
     /// asked for more).
     pub runs: u32,
+    /// Gathering the irradiance at calculation points (`solve --points`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<f64>,
 }
 
 /// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
@@ -67,6 +70,12 @@ pub struct Stats {
     pub power_absorbed: f64,
     /// Input warnings (degenerate faces skipped, etc.).
     pub warnings: crate::scene::SceneWarnings,
+    /// Calculation points gathered (`solve --points`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<usize>,
+    /// Visibility rays cast for the calculation points (absent without `--points`; not in `rays`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub point_rays: Option<u64>,
 }
 
 /// Peak resident set size of this process (`VmHWM` on Linux).
@@ -138,6 +147,7 @@ impl Stats {
                 output,
                 total,
                 runs: 1,
+                points: None,
             },
             peak_rss_bytes: peak_rss_bytes(),
             left_out: solved.left_out.clone(),
@@ -145,6 +155,8 @@ impl Stats {
             power_emitted,
             power_absorbed,
             warnings: scene.warnings.clone(),
+            points: None,
+            point_rays: None,
         }
     }
 }
