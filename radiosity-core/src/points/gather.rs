@@ -359,6 +359,15 @@ impl Piece {
     }
 }
 
+/// The parameters (in [0, 1]) of the sample standing for the parameter-grid point `g` (scaled by
+/// `scale`) of a leaf of `n_vertices`: drawn toward the leaf's centre by [`SAMPLE_INSET`] and
+/// shifted by [`SAMPLE_SHIFT`].
+fn sample_param(g: [f64; 2], scale: f64, n_vertices: usize) -> [f64; 2] {
+    let centre = if n_vertices == 3 { 1.0 / 3.0 } else { 0.5 };
+    let (u, v) = (g[0] / scale, g[1] / scale);
+    [u + SAMPLE_INSET * (centre - u + SAMPLE_SHIFT[0]), v + SAMPLE_INSET * (centre - v + SAMPLE_SHIFT[1])]
+}
+
 /// The visibility search from one point, leaf after leaf.
 struct Shot<'c> {
     caster: &'c RayCaster,
@@ -399,11 +408,8 @@ impl Shot<'_> {
         if let Some(clear) = key.and_then(|k| self.cache.get(&k).copied()) {
             return clear;
         }
-        let scale = f64::from(self.scale);
-        let centre = if self.leaf.n_vertices() == 3 { scale / 3.0 } else { scale / 2.0 };
-        let u = g[0] + SAMPLE_INSET * (centre - g[0] + SAMPLE_SHIFT[0] * scale);
-        let v = g[1] + SAMPLE_INSET * (centre - g[1] + SAMPLE_SHIFT[1] * scale);
-        let clear = self.clear(self.leaf.point(u / scale, v / scale));
+        let [u, v] = sample_param(g, f64::from(self.scale), self.leaf.n_vertices());
+        let clear = self.clear(self.leaf.point(u, v));
         if let Some(k) = key {
             let _ = self.cache.insert(k, clear);
         }
@@ -462,5 +468,56 @@ impl Shot<'_> {
             }
         }
         sum
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> Poly {
+        Poly::quad(DVec3::new(0.0, 0.0, 0.0), DVec3::new(2.0, 0.1, 0.0), DVec3::new(2.5, 1.7, 0.0), DVec3::new(-0.3, 1.2, 0.0))
+    }
+
+    fn triangle() -> Poly {
+        Poly::triangle(DVec3::new(0.0, 0.0, 1.0), DVec3::new(2.0, 0.3, 1.0), DVec3::new(0.4, 1.5, 1.0))
+    }
+
+    /// The pieces in parameters are the hierarchy's regular subdivision (`Poly::subdivide`), two
+    /// levels down, so each piece's form factor is that of the element the hierarchy would make.
+    #[test]
+    fn pieces_are_the_regular_subdivision() {
+        let scale = 2 << SHADOW_DEPTH;
+        for poly in [quad(), triangle()] {
+            let at = |g: [u32; 2]| poly.point(f64::from(g[0]) / f64::from(scale), f64::from(g[1]) / f64::from(scale));
+            let leaf = Piece::leaf(&poly, scale);
+            for (piece, child) in leaf.children().iter().zip(poly.subdivide()) {
+                for (grand, grand_child) in piece.children().iter().zip(child.subdivide()) {
+                    for (k, v) in grand_child.vertices().iter().enumerate() {
+                        let d = (at(grand.corners[k]) - *v).length();
+                        assert!(d <= 1e-12, "{:?} corner {k}: {d}", poly.kind);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every sample of the finest grid lies strictly inside its leaf, off its edges, and within
+    /// the inset of its grid point.
+    #[test]
+    fn samples_stay_inside_the_leaf() {
+        let n = 1u32 << (SHADOW_DEPTH + 1);
+        let scale = f64::from(n);
+        for n_vertices in [3, 4] {
+            for i in 0..=n {
+                for j in (0..=n).filter(|&j| n_vertices == 4 || i + j <= n) {
+                    let (gu, gv) = (f64::from(i) / scale, f64::from(j) / scale);
+                    let [u, v] = sample_param([f64::from(i), f64::from(j)], scale, n_vertices);
+                    let margin = if n_vertices == 3 { u.min(v).min(1.0 - u - v) } else { u.min(v).min(1.0 - u).min(1.0 - v) };
+                    assert!(margin > 1e-3 * SAMPLE_INSET, "{n_vertices} vertices, grid ({i}, {j}): ({u}, {v})");
+                    assert!((u - gu).abs().max((v - gv).abs()) <= SAMPLE_INSET, "moved at most the inset");
+                }
+            }
+        }
     }
 }
