@@ -9,6 +9,7 @@
 //! - [`refine`]: the oracle decides per link: link here or subdivide → links
 //! - [`solve`]: gather, push-pull, GMRES on the hierarchical operator → radiosity per element
 //! - [`output`]: `image.png`, `solution.ply`, `patches.csv`, `stats.json`
+//! - [`points`]: irradiance at calculation points, gathered from the solution → `points.csv`
 #![warn(missing_docs)]
 
 pub mod analysis;
@@ -19,6 +20,7 @@ pub mod instancing;
 pub mod oracle;
 pub mod output;
 pub mod pipeline;
+pub mod points;
 pub mod refine;
 pub mod scene;
 pub mod solve;

@@ -57,6 +57,12 @@ pub struct SolveArgs {
     /// solves; outputs come from the first). For timing small scenes on a noisy machine.
     #[arg(long, default_value_t = 0.0, value_name = "SECONDS")]
     pub time_for: f64,
+    /// Calculation points: a CSV file of rows `x,y,z,nx,ny,nz` or `name,x,y,z,nx,ny,nz` (or a
+    /// header naming those columns, in any order). Writes points.csv: the irradiance gathered from
+    /// the solution on a small receiver at each point facing its normal, per channel and photopic.
+    /// Plain scenes only: refused for instanced scenes and `--instances auto`.
+    #[arg(long, value_name = "FILE.csv")]
+    pub points: Option<PathBuf>,
 }
 
 /// Most solves `--time-for` times.
@@ -90,6 +96,10 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         args.time_for == 0.0 || !(instanced || args.instances == Instances::Auto),
         "--time-for applies to plain scenes, not to instanced ones"
     );
+    anyhow::ensure!(
+        args.points.is_none() || !(instanced || args.instances == Instances::Auto),
+        "--points applies to plain scenes, not to instanced ones (nor to --instances auto)"
+    );
     if instanced {
         let path = args.scene.as_ref().expect("checked above");
         let scene = radiosity::instancing::load(path)?;
@@ -110,6 +120,8 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let reporter = Reporter::new(args.quiet);
     reporter.phase("loading scene");
+    // The points file is read first, so that a bad row stops the command before the solve.
+    let points = args.points.as_deref().map(radiosity::points::read_points).transpose()?;
     let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
     let load = t0.elapsed().as_secs_f64();
     let mut params = super::oracle::parse_params(&args.params)?;
@@ -132,6 +144,13 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             runs += 1;
         }
     }
+    let gathered = points.as_ref().map(|points| {
+        reporter.phase(&format!("gathering at {} calculation points", points.len()));
+        let t = Instant::now();
+        let config = radiosity::points::PointsConfig { use_visibility: config.use_visibility, ..Default::default() };
+        let results = radiosity::points::gather(&solved, points, &config);
+        (points, results, t.elapsed().as_secs_f64())
+    });
     reporter.phase("writing outputs");
     let t_out = Instant::now();
     let oracle_params: serde_json::Map<String, serde_json::Value> = params.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect();
@@ -150,6 +169,16 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     let out_config =
         OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
+    if let Some((points, results, seconds)) = &gathered {
+        let path = args.out.join("points.csv");
+        let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
+        output::write_points_csv(&mut w, points, results)
+            .and_then(|()| std::io::Write::flush(&mut w))
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+        stats.points = Some(points.len());
+        stats.point_rays = Some(results.iter().map(|r| r.rays).sum());
+        stats.time_s.points = Some(*seconds);
+    }
     stats.time_s.output = t_out.elapsed().as_secs_f64();
     stats.time_s.total = t0.elapsed().as_secs_f64();
     stats.time_s.runs = runs;
@@ -209,7 +238,11 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
     for w in &s.solve_warnings {
         eprintln!("warning: {w}");
     }
-    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json}}", out.display());
+    if let (Some(n), Some(seconds)) = (s.points, s.time_s.points) {
+        println!("points: irradiance at {n} calculation points in {seconds:.3}s ({} rays)", s.point_rays.unwrap_or(0));
+    }
+    let points = if s.points.is_some() { ",points.csv" } else { "" };
+    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json{points}}}", out.display());
 }
 
 /// An instanced scene (a `.toml` file, or a plain scene after `--instances auto`, whose `auto`

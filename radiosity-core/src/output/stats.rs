@@ -21,6 +21,9 @@ pub struct StatsTimes {
     /// Solves timed: build, refine and solve are the fastest of them (1 unless `solve --time-for`
     /// asked for more).
     pub runs: u32,
+    /// Gathering the irradiance at calculation points (`solve --points`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<f64>,
 }
 
 /// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
@@ -85,6 +88,12 @@ pub struct Stats {
     pub solve_warnings: Vec<String>,
     /// Input warnings (degenerate faces skipped, etc.).
     pub warnings: crate::scene::SceneWarnings,
+    /// Calculation points gathered (`solve --points`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<usize>,
+    /// Visibility rays cast for the calculation points (absent without `--points`; not in `rays`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub point_rays: Option<u64>,
 }
 
 /// Peak resident set size of this process (`VmHWM` on Linux).
@@ -158,6 +167,7 @@ impl Stats {
                 output,
                 total,
                 runs: 1,
+                points: None,
             },
             peak_rss_bytes: peak_rss_bytes(),
             left_out: solved.left_out.clone(),
@@ -170,6 +180,8 @@ impl Stats {
             memory_limited: solved.memory_limited,
             solve_warnings: solved.warnings.clone(),
             warnings: scene.warnings.clone(),
+            points: None,
+            point_rays: None,
         }
     }
 }

@@ -1,0 +1,69 @@
+//! Step 6, `points`: irradiance at calculation points, gathered from a solved hierarchy, as
+//! lighting programs are validated and read (CIE 171:2006).
+//!
+//! A calculation point is a position and a normal: a small receiver facing the normal. Its
+//! irradiance is gathered from every leaf of the solution, `H(x) = Σ B_leaf · F(dx → leaf) ·
+//! V(x, leaf)`, with Lambert's exact point-to-polygon form factor and visibility by rays; a leaf
+//! the point sees in part is subdivided adaptively ([`SHADOW_DEPTH`]). See [`gather`] for the
+//! contract, [`read_points`] for the file format and [`crate::output::write_points_csv`] for
+//! `points.csv`.
+
+mod gather;
+mod read;
+
+pub use gather::{
+    MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET, SAMPLE_SHIFT, SHADOW_DEPTH,
+    SHADOW_EDGE_REL_ERROR, UNIFORM_MAX_SUBTENSE, gather,
+};
+pub use read::{PointsError, parse_points, read_points};
+
+use crate::geom::DVec3;
+
+/// Rec. 709 (sRGB) luminance weights of the red, green and blue channels: the photopic value of a
+/// colour is `0.2126·r + 0.7152·g + 0.0722·b`. They sum to 1, so a grey irradiance keeps its value.
+pub const PHOTOPIC_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// The photopic (luminance-weighted) value of an RGB irradiance, with [`PHOTOPIC_WEIGHTS`]
+/// (W/m² for radiometric scenes).
+#[must_use]
+pub fn photopic(h: [f64; 3]) -> f64 {
+    PHOTOPIC_WEIGHTS[0] * h[0] + PHOTOPIC_WEIGHTS[1] * h[1] + PHOTOPIC_WEIGHTS[2] * h[2]
+}
+
+/// A calculation point: where a small receiver is, and which way it faces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CalcPoint {
+    /// Its label in `points.csv`.
+    pub name: String,
+    /// Position, scene units.
+    pub position: DVec3,
+    /// Unit normal: the receiver gathers light arriving from this side.
+    pub normal: DVec3,
+}
+
+impl CalcPoint {
+    /// A point facing `normal`, which need not be unit length (it is normalised); `None` when the
+    /// normal is zero or a coordinate is not finite.
+    #[must_use]
+    pub fn new(name: impl Into<String>, position: DVec3, normal: DVec3) -> Option<CalcPoint> {
+        let normal = normal.try_normalize()?;
+        position.is_finite().then(|| CalcPoint { name: name.into(), position, normal })
+    }
+}
+
+/// The irradiance gathered at one calculation point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointIrradiance {
+    /// Irradiance per channel on the receiver's side (W/m²).
+    pub h: [f64; 3],
+    /// Visibility rays cast for this point (0 where none were needed).
+    pub rays: u64,
+}
+
+impl PointIrradiance {
+    /// The photopic value of [`PointIrradiance::h`] (see [`photopic`]).
+    #[must_use]
+    pub fn photopic(&self) -> f64 {
+        photopic(self.h)
+    }
+}
