@@ -34,6 +34,27 @@ pub struct Case {
 
 /// The dense reference of Ward's room (see [`dense`], `examples/validation_reference.rs`).
 pub const WARD_ROOM_CSV: &str = include_str!("../../data/validation/ward_room.csv");
+/// Ward's room's radiosity at its 480 calculation points (floor and ceiling, every 0.5 m from 0.25
+/// m off the walls): a constant-element Galerkin solve with exact form factors on three uniform
+/// meshes, an exact final gather at each point, Richardson-extrapolated (column
+/// `B_richardson_h2`, accurate to 0.2%; `reference/globillum1990_room.md` of the shared references).
+pub const WARD_ROOM_POINTS_CSV: &str = include_str!("../../data/validation/ward_room_points.csv");
+
+/// Ward's room's calculation points: `(surface, x, y, B)`, surface `floor` (z = 0, facing up) or
+/// `ceiling` (z = 3, facing down), `B` the reference radiosity (W/m²).
+#[must_use]
+pub fn ward_room_points() -> Vec<(String, f64, f64, f64)> {
+    WARD_ROOM_POINTS_CSV
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            Some((f.first()?.to_string(), f.get(1)?.parse().ok()?, f.get(2)?.parse().ok()?, f.get(7)?.parse().ok()?))
+        })
+        .collect()
+}
+
 /// The dense references of the bright-corner room at ρ = 0.3, 0.7, 0.95.
 pub const CORNER_ROOM_CSV: &str = include_str!("../../data/validation/corner_room.csv");
 
