@@ -410,9 +410,8 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         (Some(target), Some(e)) if e > target => {
             warnings.push(format!("target error {target} not reached: estimate {e:.3e} after {} levels", levels.len()))
         }
-        (Some(target), None) => warnings.push(format!(
-            "target error {target} not checked: the leaf-resolution solve, which the estimate needs, is over its budget"
-        )),
+        (Some(target), None) => warnings
+            .push(format!("target error {target} not checked: the leaf-resolution solve, which the estimate needs, is over its budget")),
         _ => {}
     }
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);

@@ -93,7 +93,12 @@ fn print_table(name: &str, args: &StudyArgs, n_links: usize, rows: &[StudyRow], 
     println!(
         "{name}: {n_links} links of a BF solve (eps {}, seed {}); each link classified as visible, invisible or partly \
          visible by {} rays (reference) and by {}, {} and {} rays",
-        args.options.eps(), args.options.common.seed, REFERENCE_RAYS, STUDY_RAYS[0], STUDY_RAYS[1], STUDY_RAYS[2]
+        args.options.eps(),
+        args.options.common.seed,
+        REFERENCE_RAYS,
+        STUDY_RAYS[0],
+        STUDY_RAYS[1],
+        STUDY_RAYS[2]
     );
     println!();
     println!(

@@ -184,7 +184,7 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
 /// Error against run time, log–log: `(series, time_s, error %, estimate %)` points (estimates as
 /// hollow circles where positive).
 pub fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> String {
-    let (w, h, m) = (640.0, 420.0, 60.0);
+    let (w, h, m) = (760.0, 460.0, 60.0);
     let pos: Vec<&(String, f64, f64, f64)> = points.iter().filter(|p| p.1 > 0.0 && p.2 > 0.0).collect();
     let lx = |v: f64| v.log10();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
@@ -254,7 +254,13 @@ pub fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> String {
                 let _ = writeln!(s, "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"none\" stroke=\"{c}\"/>", sx(p.1), sy(p.3));
             }
         }
-        let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" fill=\"{c}\">{}</text>", w - 1.4 * m, m + 16.0 * i as f64, xml(name));
+        let _ = writeln!(
+            s,
+            "<text x=\"{}\" y=\"{}\" fill=\"{c}\" text-anchor=\"end\">{}</text>",
+            w - m / 2.0 - 4.0,
+            h - m - 8.0 - 16.0 * (names.len() - 1 - i) as f64,
+            xml(name)
+        );
     }
     s.push_str("</svg>\n");
     s
