@@ -5,7 +5,7 @@
 //! every other solve uses the BF oracle ([`super::BfHand`], [`crate::oracle::bf`]), whose
 //! thresholds are relative to each receiver's own irradiance.
 
-use super::{Decision, LinkCtx, Oracle, emitter_first};
+use super::{Decision, LinkCtx, Oracle};
 use crate::scene::Scene;
 
 /// The classic BF oracle: `B_S · F_max` against `eps · b_ref`.
@@ -34,19 +34,7 @@ impl Oracle for ClassicBf {
         if b * f <= self.eps * self.b_ref {
             return Decision::Link;
         }
-        let h = ctx.hierarchy();
-        match (h.can_subdivide(ctx.emitter), h.can_subdivide(ctx.receiver)) {
-            (false, false) => Decision::Link,
-            (true, false) => Decision::SubdivideEmitter,
-            (false, true) => Decision::SubdivideReceiver,
-            (true, true) => {
-                if emitter_first(ctx.emitter_element(), ctx.receiver_element()) {
-                    Decision::SubdivideEmitter
-                } else {
-                    Decision::SubdivideReceiver
-                }
-            }
-        }
+        super::bf_hand::split(ctx)
     }
 }
 

@@ -81,7 +81,7 @@ pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
 }
 
 /// Subdivides what can be: [`emitter_first`] picks between two that can; link when neither can.
-fn split(ctx: &LinkCtx<'_>) -> Decision {
+pub(super) fn split(ctx: &LinkCtx<'_>) -> Decision {
     let h = ctx.hierarchy();
     match (h.can_subdivide(ctx.emitter), h.can_subdivide(ctx.receiver)) {
         (false, false) => Decision::Link,

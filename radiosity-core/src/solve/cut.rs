@@ -148,20 +148,7 @@ impl<'a> Cut<'a> {
                 b[e] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
             }
         }
-        for &e in self.above.iter().rev() {
-            let mut acc = [0.0; 3];
-            let mut area = 0.0;
-            for &c in h.children_of(e) {
-                let a = h.get(c).area;
-                for k in 0..3 {
-                    acc[k] += a * b[c as usize][k];
-                }
-                area += a;
-            }
-            if area > 0.0 {
-                b[e as usize] = acc.map(|v| v / area);
-            }
-        }
+        super::final_gather::area_means(h, &self.above, &mut b);
         b
     }
 

@@ -53,8 +53,8 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
 }
 
 /// Sets every inner element of `order` (parents before children) to the area-weighted mean of its
-/// children.
-fn area_means(h: &Hierarchy, order: &[ElementId], values: &mut [[f64; 3]]) {
+/// children (children first: `order` is walked backwards).
+pub(super) fn area_means(h: &Hierarchy, order: &[ElementId], values: &mut [[f64; 3]]) {
     for &e in order.iter().rev() {
         let kids = h.children_of(e);
         if kids.is_empty() {

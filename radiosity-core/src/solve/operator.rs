@@ -149,24 +149,7 @@ impl<'a> Operator<'a> {
         for (i, &e) in self.leaves.iter().enumerate() {
             b[e as usize] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
         }
-        for &e in self.order.iter().rev() {
-            let el = self.h.get(e);
-            if el.n_children == 0 {
-                continue;
-            }
-            let mut acc = [0.0; 3];
-            let mut area = 0.0;
-            for &c in self.h.children_of(e) {
-                let a = self.h.get(c).area;
-                for k in 0..3 {
-                    acc[k] += a * b[c as usize][k];
-                }
-                area += a;
-            }
-            if area > 0.0 {
-                b[e as usize] = acc.map(|v| v / area);
-            }
-        }
+        super::final_gather::area_means(self.h, &self.order, &mut b);
         b
     }
 
