@@ -383,12 +383,12 @@ fn cli_writes_points_csv_in_input_order() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = std::fs::read_to_string(dir.path().join("o/points.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic"));
+    assert_eq!(lines.next(), Some("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units"));
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 3, "{csv}");
     assert!(rows[0].starts_with("floor under the lamp,278,0,280,0,1,0,"), "normal written normalised: {}", rows[0]);
     assert!(rows[1].starts_with("\"back of the ceiling, up\","), "{}", rows[1]);
-    let values = |row: &str| -> Vec<f64> { row.rsplit(',').take(4).map(|v| v.parse().unwrap()).collect::<Vec<_>>() };
+    let values = |row: &str| -> Vec<f64> { row.rsplit(',').skip(1).take(4).map(|v| v.parse().unwrap()).collect::<Vec<_>>() };
     for row in [rows[0], rows[2]] {
         let v = values(row); // photopic, b, g, r
         assert!(v.iter().all(|&h| h > 0.0), "a point facing the lit room gets light: {row}");

@@ -278,6 +278,8 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let use_visibility = config.use_visibility && traits.as_ref().is_none_or(|t| t.needs_visibility);
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
+    // Luminaires: surfaces split for their light, every element's direct illuminance.
+    crate::luminaire::prepare(&mut h, config.use_visibility.then_some(&caster));
     let shaft_objects = match effective_visibility(oracle, config.visibility_method) {
         VisibilityMethod::Shafts(volume) if use_visibility => Some(crate::visibility::shaft::ShaftObjects::new(
             scene,
@@ -336,6 +338,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
                 &|l, p| progress(Progress::Refine { level: level + 1, pass, links: l, pending: p }),
             );
             links = new_links;
+            crate::luminaire::update_direct(&mut h, config.use_visibility.then_some(&caster));
             timings.refine += t.elapsed().as_secs_f64();
             stats.oracle_calls += s.oracle_calls;
             stats.form_factors += s.form_factors;
@@ -396,7 +399,13 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             break;
         }
     }
-    let solution = solution.expect("at least one level solves");
+    let mut solution = solution.expect("at least one level solves");
+    // The luminaires' direct light is part of what each surface receives.
+    for (irr, &d) in solution.irradiance.iter_mut().zip(&h.direct) {
+        for v in irr.iter_mut() {
+            *v += d;
+        }
+    }
     let error_estimate = levels.last().and_then(|l| l.error_estimate);
     let mut warnings = Vec::new();
     if stats.refused_for_memory > 0 {

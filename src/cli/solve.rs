@@ -91,21 +91,27 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         "--level-cache-mb must be between 0 and 1e6, got {}",
         args.level_cache_mb
     );
-    let instanced = args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")));
-    anyhow::ensure!(
-        args.time_for == 0.0 || !(instanced || args.instances == Instances::Auto),
-        "--time-for applies to plain scenes, not to instanced ones"
-    );
-    anyhow::ensure!(
-        args.points.is_none() || !(instanced || args.instances == Instances::Auto),
-        "--points applies to plain scenes, not to instanced ones (nor to --instances auto)"
-    );
-    if instanced {
+    let toml = args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")));
+    // A scene file with luminaires or photometric units is flattened and solved as a plain scene.
+    let mut lit_scene = None;
+    if toml {
         let path = args.scene.as_ref().expect("checked above");
-        let scene = radiosity::instancing::load(path)?;
-        return solve_instanced(args, &scene, None);
+        let (scene, lighting) = radiosity::instancing::load_with_lighting(path)?;
+        if lighting.needs_plain_solve() {
+            anyhow::ensure!(args.instances == Instances::None, "--instances auto applies to plain OBJ / MGF scenes");
+            let mut plain = radiosity::instancing::flatten(&scene, &radiosity::instancing::FlattenOptions::default())?;
+            plain.luminaires = lighting.luminaires;
+            plain.units = lighting.units;
+            lit_scene = Some(plain);
+        } else {
+            anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
+            anyhow::ensure!(args.points.is_none(), "--points applies to plain scenes, not to instanced ones (nor to --instances auto)");
+            return solve_instanced(args, &scene, None);
+        }
     }
     if args.instances == Instances::Auto {
+        anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
+        anyhow::ensure!(args.points.is_none(), "--points applies to plain scenes, not to instanced ones (nor to --instances auto)");
         let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
         let t0 = Instant::now();
         let auto = radiosity::instancing::auto_instance(&scene, &radiosity::instancing::AutoOptions::default());
@@ -122,7 +128,10 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     reporter.phase("loading scene");
     // The points file is read first, so that a bad row stops the command before the solve.
     let points = args.points.as_deref().map(radiosity::points::read_points).transpose()?;
-    let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
+    let scene = match lit_scene {
+        Some(scene) => scene,
+        None => load_scene(args.scene.as_ref(), args.options.common.allow_dark)?,
+    };
     let load = t0.elapsed().as_secs_f64();
     let mut params = super::oracle::parse_params(&args.params)?;
     if !params.iter().any(|(k, _)| k == "eps") {
@@ -172,7 +181,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     if let Some((points, results, seconds)) = &gathered {
         let path = args.out.join("points.csv");
         let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
-        output::write_points_csv(&mut w, points, results)
+        output::write_points_csv_in(&mut w, points, results, scene.units)
             .and_then(|()| std::io::Write::flush(&mut w))
             .with_context(|| format!("{}: cannot write", path.display()))?;
         stats.points = Some(points.len());
@@ -234,7 +243,12 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         );
     }
     let closed = if s.closed { "closed scene: each surface's light delivered whole" } else { "open scene" };
-    println!("power: emitted {:.6e} W, absorbed {:.6e} W (balance {:.5}; {closed})", s.power_emitted, s.power_absorbed, balance);
+    let unit = s.units.power_label();
+    println!("power: emitted {:.6e} {unit}, absorbed {:.6e} {unit} (balance {:.5}; {closed})", s.power_emitted, s.power_absorbed, balance);
+    for l in &s.luminaires {
+        let declared = l.declared_lm.map_or(String::new(), |d| format!(" (file declares {d:.1} lm)"));
+        println!("luminaire {}: {:.1} lm{declared}", l.name, l.flux_lm);
+    }
     for w in &s.solve_warnings {
         eprintln!("warning: {w}");
     }

@@ -83,6 +83,8 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         transmittance,
         twin,
         min_area: config.min_area_rel * total_area,
+        luminaires: scene.luminaires.clone(),
+        direct: Vec::new(),
     };
     let centroids: Vec<DVec3> = h.elements.iter().map(|e| e.center).collect();
     h.root = build_cluster(&mut h, &centroids, 0, n, 0, config.max_leaf_polygons.max(2));

@@ -116,6 +116,12 @@ pub struct Hierarchy {
     pub twin: Vec<u32>,
     /// Smallest area a surface element may be subdivided into.
     pub min_area: f64,
+    /// The scene's luminaires (photometric point sources), whose light enters through
+    /// [`Hierarchy::direct`].
+    pub luminaires: Vec<crate::luminaire::Luminaire>,
+    /// Direct illuminance from the luminaires per element (area mean over a surface element; 0 for
+    /// clusters), filled by [`crate::luminaire::update_direct`]; empty without luminaires.
+    pub direct: Vec<f64>,
 }
 
 impl Hierarchy {
@@ -184,6 +190,31 @@ impl Hierarchy {
     /// Leaves (elements without children), in id order.
     pub fn leaves(&self) -> impl Iterator<Item = ElementId> + '_ {
         (0..self.elements.len() as ElementId).filter(|&i| self.elements[i as usize].n_children == 0)
+    }
+
+    /// The emission of surface element `id` in the radiosity system: its polygon's own emission
+    /// plus the reflection of the luminaires' direct light, `E + ρ·E_direct + t·Ē_direct(other
+    /// side)` (see [`crate::luminaire`]).
+    #[must_use]
+    #[inline]
+    pub fn emission_of(&self, id: ElementId) -> [f64; 3] {
+        let Some(p) = self.get(id).polygon() else { return [0.0; 3] };
+        let p = p as usize;
+        let own = self.emission[p];
+        if self.direct.is_empty() {
+            return own;
+        }
+        let d = self.direct.get(id as usize).copied().unwrap_or(0.0);
+        let twin = self.twin[p];
+        let other = if twin == NONE { 0.0 } else { self.direct.get(twin as usize).copied().unwrap_or(0.0) };
+        std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d + self.transmittance[p][c] * other)
+    }
+
+    /// The length of the diagonal of the scene's bounding box.
+    #[must_use]
+    pub fn diagonal(&self) -> f64 {
+        let b = &self.get(self.root).bounds;
+        (b.max - b.min).length()
     }
 
     /// Reflectance of a surface element's polygon; the area-weighted mean for a cluster.

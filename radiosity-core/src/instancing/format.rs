@@ -110,6 +110,58 @@ pub struct PolygonSpec {
     pub vertices: Vec<[f64; 3]>,
 }
 
+/// `[[luminaire]]`: a photometric file placed in the scene (see [`crate::luminaire::Luminaire::new`]).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LuminaireSpec {
+    /// An IES LM-63 file, relative to the scene file's folder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ies: Option<String>,
+    /// A EULUMDAT file, relative to the scene file's folder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ldt: Option<String>,
+    /// Name in messages (default: the file's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Photometric centre.
+    pub position: [f64; 3],
+    /// Direction of the photometric nadir (γ = 0); default straight down, −z.
+    #[serde(default = "default_aim")]
+    pub aim: [f64; 3],
+    /// Degrees about the aim, turning the C = 0 plane.
+    #[serde(default)]
+    pub rotate: f64,
+    /// Scales every intensity.
+    #[serde(default = "default_multiplier")]
+    pub multiplier: f64,
+}
+
+fn default_aim() -> [f64; 3] {
+    [0.0, 0.0, -1.0]
+}
+
+fn default_multiplier() -> f64 {
+    1.0
+}
+
+/// What a scene file says about light and units beyond its geometry: `units` and `[[luminaire]]`.
+#[derive(Clone, Debug, Default)]
+pub struct Lighting {
+    /// `units = "radiometric"` (default) or `"photometric"`.
+    pub units: crate::photometry::Units,
+    /// The luminaires, placed.
+    pub luminaires: Vec<crate::luminaire::Luminaire>,
+}
+
+impl Lighting {
+    /// Whether the file asks for anything the instanced solver does not do (luminaires, photometric
+    /// units): such a scene is flattened and solved as a plain scene.
+    #[must_use]
+    pub fn needs_plain_solve(&self) -> bool {
+        !self.luminaires.is_empty() || self.units != crate::photometry::Units::Radiometric
+    }
+}
+
 /// `[[prototype]]`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -148,17 +200,32 @@ struct FileSpec {
     polygon: Vec<Spanned<PolygonSpec>>,
     #[serde(default)]
     instance: Vec<Spanned<InstanceSpec>>,
+    #[serde(default)]
+    units: Option<crate::photometry::Units>,
+    #[serde(default)]
+    luminaire: Vec<Spanned<LuminaireSpec>>,
 }
 
 /// Reads a scene file with instances. Prototype OBJ paths are relative to the file's folder.
 pub fn load(path: &Path) -> Result<InstancedScene, InstancingError> {
+    load_with_lighting(path).map(|(scene, _)| scene)
+}
+
+/// Reads a scene file with its [`Lighting`] (units and luminaires; photometric files are relative
+/// to the scene file's folder).
+pub fn load_with_lighting(path: &Path) -> Result<(InstancedScene, Lighting), InstancingError> {
     let text = std::fs::read_to_string(path).map_err(|e| InstancingError::io(path, "cannot read file", e))?;
     let dir = path.parent().map(Path::to_owned).unwrap_or_default();
-    parse(&text, path, &dir)
+    parse_with_lighting(&text, path, &dir)
 }
 
 /// Parses scene text; `path` names it in messages and `dir` is where relative OBJ paths start.
 pub fn parse(text: &str, path: &Path, dir: &Path) -> Result<InstancedScene, InstancingError> {
+    parse_with_lighting(text, path, dir).map(|(scene, _)| scene)
+}
+
+/// [`parse`] with the file's [`Lighting`].
+pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(InstancedScene, Lighting), InstancingError> {
     let line_of = |offset: usize| text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1;
     let spec: FileSpec = toml::from_str(text).map_err(|e| {
         let line = e.span().map_or(0, |s| line_of(s.start));
@@ -229,7 +296,32 @@ pub fn parse(text: &str, path: &Path, dir: &Path) -> Result<InstancedScene, Inst
     let name = spec.name.unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     let scene = InstancedScene { name, path: path.to_owned(), materials, prototypes, root };
     scene.validate()?;
-    Ok(scene)
+    let units = spec.units.unwrap_or_default();
+    let mut luminaires = Vec::with_capacity(spec.luminaire.len());
+    for l in &spec.luminaire {
+        let line = line_of(l.span().start);
+        let ls = l.get_ref();
+        let file = match (&ls.ies, &ls.ldt) {
+            (Some(f), None) | (None, Some(f)) => f,
+            _ => return Err(InstancingError::at(path, line, "a luminaire needs one of `ies` or `ldt`")),
+        };
+        if units != crate::photometry::Units::Photometric {
+            return Err(InstancingError::at(path, line, "luminaires need `units = \"photometric\"` (their intensities are in cd)"));
+        }
+        let photometry = crate::photometry::read(&dir.join(file)).map_err(|e| InstancingError::at(path, line, e.to_string()))?;
+        let name = ls.name.clone().unwrap_or_else(|| file.clone());
+        let lum = crate::luminaire::Luminaire::new(
+            &name,
+            std::sync::Arc::new(photometry),
+            DVec3::from(ls.position),
+            DVec3::from(ls.aim),
+            ls.rotate,
+            ls.multiplier,
+        )
+        .map_err(|e| InstancingError::at(path, line, e.to_string()))?;
+        luminaires.push(lum);
+    }
+    Ok((scene, Lighting { units, luminaires }))
 }
 
 struct Ctx<'a> {

@@ -61,7 +61,7 @@ pub use auto::{AutoOptions, AutoReport, AutoResult, auto_instance};
 pub use caster::InstanceCaster;
 pub use error::InstancingError;
 pub use flatten::{FlattenOptions, flatten, flatten_prototype};
-pub use format::{load, parse};
+pub use format::{Lighting, LuminaireSpec, load, load_with_lighting, parse, parse_with_lighting};
 pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
 pub use output::{StreamedOutput, StreamedSummary};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};

@@ -66,7 +66,7 @@ impl StreamedOutput {
         };
         let (spool_path, spool) = open("solution.spool")?;
         let (csv_path, mut csv) = open("patches.csv")?;
-        writeln!(csv, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b").map_err(|e| io_err(&csv_path, e))?;
+        writeln!(csv, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b,units").map_err(|e| io_err(&csv_path, e))?;
         Ok(StreamedOutput {
             dir: dir.to_owned(),
             spool_path,
@@ -268,7 +268,7 @@ impl RadiositySink for StreamedOutput {
         let material = self.material_names.get(info.material as usize).map_or("", String::as_str);
         writeln!(
             self.csv,
-            "{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            "{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},W/m2",
             info.flat_index,
             crate::output::csv_field(group),
             crate::output::csv_field(material),

@@ -1,5 +1,6 @@
 //! `patches.csv`: one row per input polygon, in input order:
-//! `index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b` (area-weighted means over the polygon's leaves).
+//! `index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b,units` (area-weighted means over the polygon's
+//! leaves; `units` is `W/m2`, or `lm/m2` in photometric scenes: radiosity in lm/m², irradiance in lx).
 
 use crate::hierarchy::Hierarchy;
 use crate::scene::Scene;
@@ -42,11 +43,12 @@ pub fn polygon_results(h: &Hierarchy, solution: &Solution) -> Vec<PolygonResult>
 
 /// Writes `patches.csv`.
 pub fn write_patches_csv(w: &mut impl Write, scene: &Scene, results: &[PolygonResult]) -> std::io::Result<()> {
-    writeln!(w, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b")?;
+    writeln!(w, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b,units")?;
+    let units = scene.units.density_label();
     for (i, (p, r)) in scene.polygons.iter().zip(results).enumerate() {
         writeln!(
             w,
-            "{i},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            "{i},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{units}",
             csv_field(&scene.groups[p.group as usize]),
             csv_field(&scene.materials[p.material as usize].name),
             r.area,

@@ -12,7 +12,7 @@ mod write;
 
 pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
 pub use ply::write_ply;
-pub use points::write_points_csv;
+pub use points::{write_points_csv, write_points_csv_in};
 pub use render::{RenderConfig, ToneMap, render, write_png};
 pub use smooth::CornerValues;
 pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};

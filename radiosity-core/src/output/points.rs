@@ -1,7 +1,9 @@
 //! `points.csv` (with `radiosity solve --points FILE`): one row per calculation point, in input
-//! order: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic`.
+//! order: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units` (`e_lx` in photometric scenes;
+//! `units` is `W/m2` or `lm/m2`).
 
 use super::csv_field;
+use crate::photometry::Units;
 use crate::points::{CalcPoint, PointIrradiance};
 use std::io::Write;
 
@@ -9,12 +11,21 @@ use std::io::Write;
 /// normalised), irradiance per channel (W/m²) and its photopic value
 /// ([`crate::points::PHOTOPIC_WEIGHTS`]).
 pub fn write_points_csv(w: &mut impl Write, points: &[CalcPoint], results: &[PointIrradiance]) -> std::io::Result<()> {
-    writeln!(w, "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic")?;
+    write_points_csv_in(w, points, results, Units::Radiometric)
+}
+
+/// [`write_points_csv`] in the scene's `units`: photometric scenes get the illuminance `e_lx`
+/// (the photopic value, lx) too.
+pub fn write_points_csv_in(w: &mut impl Write, points: &[CalcPoint], results: &[PointIrradiance], units: Units) -> std::io::Result<()> {
+    let photometric = units == Units::Photometric;
+    writeln!(w, "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic{},units", if photometric { ",e_lx" } else { "" })?;
+    let label = units.density_label();
     for (p, r) in points.iter().zip(results) {
         let (x, n) = (p.position, p.normal);
+        let lux = if photometric { format!(",{:e}", r.photopic()) } else { String::new() };
         writeln!(
             w,
-            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e}",
+            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e}{lux},{label}",
             csv_field(&p.name),
             x.x,
             x.y,

@@ -69,9 +69,9 @@ pub struct Stats {
     pub left_out: Vec<String>,
     /// Area-weighted mean radiosity of the leaves [r, g, b] (W/m²).
     pub radiosity_mean: [f64; 3],
-    /// Emitted power Σ A·E (W, summed over channels divided by 3).
+    /// Emitted power Σ A·E plus the luminaires' flux (W or lm, summed over channels divided by 3).
     pub power_emitted: f64,
-    /// Absorbed power Σ A·(1−ρ)·H (W, same channel mean).
+    /// Absorbed power Σ A·(1−ρ)·H (W or lm, same channel mean).
     pub power_absorbed: f64,
     /// Absorbed over emitted power (null when nothing emits): 1 in a closed scene.
     pub power_balance: Option<f64>,
@@ -94,6 +94,24 @@ pub struct Stats {
     /// Visibility rays cast for the calculation points (absent without `--points`; not in `rays`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub point_rays: Option<u64>,
+    /// `radiometric` (power in W, radiosity and irradiance in W/m²) or `photometric` (lm, lm/m²,
+    /// lx).
+    pub units: crate::photometry::Units,
+    /// The luminaires (photometric scenes; absent without).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub luminaires: Vec<LuminaireStats>,
+}
+
+/// One luminaire in `stats.json`.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LuminaireStats {
+    /// Its name.
+    pub name: String,
+    /// The flux leaving it (lm): its photometric file's, integrated, times its multiplier.
+    pub flux_lm: f64,
+    /// The lamps' flux its file declares, times its multiplier (lm; null when the file gives
+    /// absolute photometry).
+    pub declared_lm: Option<f64>,
 }
 
 /// Peak resident set size of this process (`VmHWM` on Linux).
@@ -126,6 +144,8 @@ pub fn power_balance(h: &Hierarchy, solution: &Solution) -> (f64, f64, [f64; 3])
         }
         area += e.area;
     }
+    // The luminaires' light (every channel the same luminous flux).
+    emitted += h.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum::<f64>();
     (emitted, absorbed, mean.map(|m| if area > 0.0 { m / area } else { 0.0 }))
 }
 
@@ -182,6 +202,16 @@ impl Stats {
             warnings: scene.warnings.clone(),
             points: None,
             point_rays: None,
+            units: scene.units,
+            luminaires: h
+                .luminaires
+                .iter()
+                .map(|l| LuminaireStats {
+                    name: l.name.clone(),
+                    flux_lm: l.flux(),
+                    declared_lm: l.photometry.declared_lumens.map(|d| d * l.multiplier),
+                })
+                .collect(),
         }
     }
 }

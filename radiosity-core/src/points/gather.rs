@@ -227,6 +227,27 @@ impl<'a> PointGather<'a> {
             }
         }
         out.rays = shot.map_or(0, |s| s.rays);
+        // Luminaires: their intensity toward the point, from the point's side of every surface it
+        // lies on, with one shadow ray each (cast whenever rays are, inside a convex room too: a
+        // luminaire may stand outside it).
+        for lum in &self.h.luminaires {
+            if (0..sides.len).any(|k| sides.normals[k].dot(lum.position - x) <= 0.0) {
+                continue;
+            }
+            let e = lum.illuminance_unoccluded(x, n);
+            if e <= 0.0 {
+                continue;
+            }
+            if let Some(caster) = self.caster {
+                out.rays += 1;
+                if !caster.segment_clear(origin, lum.position, NONE, NONE) {
+                    continue;
+                }
+            }
+            for c in 0..3 {
+                out.h[c] += e;
+            }
+        }
         out
     }
 }

@@ -63,17 +63,22 @@ impl ElementData {
         let mut rho_area = [0.0; 3];
         for p in 0..n {
             let a = h.get(p as u32).area;
+            let em = h.emission_of(p as u32);
             area += a;
             for c in 0..3 {
-                power[c] += a * h.emission[p][c];
+                power[c] += a * em[c];
                 rho_area[c] += a * h.reflectance[p][c];
             }
         }
         let ambient: [f64; 3] =
             std::array::from_fn(|c| if area > 0.0 { power[c] / area / (1.0 - rho_area[c] / area).max(1e-3) } else { 0.0 });
         let mut b = vec![[0.0; 3]; h.len()];
-        for p in 0..n {
-            b[p] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * ambient[c]);
+        // Surfaces (input polygons and the pieces the luminaires' light made, `crate::luminaire`).
+        for e in 0..h.len() {
+            if let Some(p) = h.get(e as u32).polygon() {
+                let em = h.emission_of(e as u32);
+                b[e] = std::array::from_fn(|c| em[c] + h.reflectance[p as usize][c] * ambient[c]);
+            }
         }
         // Clusters: area-weighted means, children before parents. The build reserves a cluster's
         // slot before building its children (pre-order), so every descendant of a cluster has a
@@ -92,7 +97,7 @@ impl ElementData {
             }
         }
         let h_ambient = ambient.iter().copied().fold(0.0, f64::max);
-        let amplification = amplification((0..n).map(|p| (h.get(p as u32).area, b[p], h.emission[p])));
+        let amplification = amplification((0..n).map(|p| (h.get(p as u32).area, b[p], h.emission_of(p as u32))));
         ElementData {
             radiosity: b,
             variation: vec![0.0; h.len()],

@@ -34,6 +34,8 @@ impl SceneBuilder {
                 groups: Vec::new(),
                 camera: None,
                 warnings: SceneWarnings::default(),
+                luminaires: Vec::new(),
+                units: crate::photometry::Units::Radiometric,
             },
             material_index: HashMap::new(),
             group_index: HashMap::new(),

@@ -129,6 +129,10 @@ pub struct Scene {
     pub camera: Option<Camera>,
     /// What was repaired or skipped.
     pub warnings: SceneWarnings,
+    /// Photometric luminaires (see [`crate::luminaire`]); only in photometric scenes.
+    pub luminaires: Vec<crate::luminaire::Luminaire>,
+    /// Radiometric (W, W/m²) or photometric (lm, lx: every channel a luminous quantity).
+    pub units: crate::photometry::Units,
 }
 
 /// Options of [`load`].

@@ -74,7 +74,7 @@ impl<'a> Cut<'a> {
         for &e in &elements {
             let p = h.get(e).polygon().expect("cut elements are surfaces") as usize;
             rho.extend_from_slice(&h.reflectance[p]);
-            emission.extend_from_slice(&h.emission[p]);
+            emission.extend_from_slice(&h.emission_of(e));
             through.push((h.transmittance[p], h.twin[p]));
         }
         if through.iter().all(|(_, q)| *q == NONE) {

@@ -46,7 +46,8 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
         // A transmitting side passes on the light of its other side.
         let q = h.twin[p];
         let through = if q == crate::hierarchy::NONE { [0.0; 3] } else { irr[q as usize] };
-        b[leaf as usize] = std::array::from_fn(|c| h.emission[p][c] + h.reflectance[p][c] * g[c] + h.transmittance[p][c] * through[c]);
+        let em = h.emission_of(leaf);
+        b[leaf as usize] = std::array::from_fn(|c| em[c] + h.reflectance[p][c] * g[c] + h.transmittance[p][c] * through[c]);
     }
     area_means(h, &order, &mut b);
     (b, irr)

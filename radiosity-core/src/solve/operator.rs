@@ -64,7 +64,7 @@ impl<'a> Operator<'a> {
         for &e in &leaves {
             let poly = h.get(e).polygon().expect("leaves are surfaces") as usize;
             rho.extend_from_slice(&h.reflectance[poly]);
-            emission.extend_from_slice(&h.emission[poly]);
+            emission.extend_from_slice(&h.emission_of(e));
         }
         let mut through: Vec<([f64; 3], ElementId)> = leaves
             .iter()

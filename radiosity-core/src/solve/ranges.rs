@@ -87,8 +87,7 @@ pub fn element_data(h: &Hierarchy, links: &[Link], sol: &Solution) -> ElementDat
     let mean = if area > 0.0 { h_sum / area } else { 0.0 };
     let amplification = amplification(leaves.iter().map(|&l| {
         let e = h.get(l);
-        let p = e.polygon().expect("leaves are surfaces") as usize;
-        (e.area, sol.radiosity[l as usize], h.emission[p])
+        (e.area, sol.radiosity[l as usize], h.emission_of(l))
     }));
     ElementData { radiosity: sol.radiosity.clone(), variation, irradiance, irradiance_floor: IRRADIANCE_FLOOR_REL * mean, amplification }
 }
@@ -104,7 +103,7 @@ fn leaf_range(h: &Hierarchy, index: &LinksByReceiver<'_>, sol: &Solution, leaf: 
     let (mut lo, mut hi) = (mean, mean);
     let (Some(poly), Some(p)) = (e.poly(), e.polygon()) else { return (lo, hi) };
     let p = p as usize;
-    let (rho, em, t, twin) = (h.reflectance[p], h.emission[p], h.transmittance[p], h.twin[p]);
+    let (rho, em, t, twin) = (h.reflectance[p], h.emission_of(leaf), h.transmittance[p], h.twin[p]);
     let through = if twin == NONE { [0.0; 3] } else { sol.irradiance[twin as usize] };
     let mut probes = [DVec3::ZERO; 5];
     probes[0] = e.center;
