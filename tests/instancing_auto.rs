@@ -161,6 +161,8 @@ fn room_with_chairs(n: usize, odd: &[ChairKind], seed: u64) -> SceneParts {
         groups,
         camera: None,
         warnings: Default::default(),
+        luminaires: Vec::new(),
+        units: Default::default(),
     };
     SceneParts { scene, odd: ranges }
 }
@@ -279,6 +281,8 @@ fn symmetric_objects_are_matched_in_any_orientation() {
         groups: (0..5).map(|k| format!("cube{k}")).collect(),
         camera: None,
         warnings: Default::default(),
+        luminaires: Vec::new(),
+        units: Default::default(),
     };
     let result = auto_instance(&scene, &AutoOptions::default());
     assert_eq!((result.report.prototypes, result.report.instances), (1, 5));

@@ -198,3 +198,40 @@ fn aim_and_rotation_turn_the_distribution() {
     assert!(Luminaire::new("bad", isotropic(1.0), DVec3::ZERO, DVec3::ZERO, 0.0, 1.0).is_err());
     assert!(Luminaire::new("bad", isotropic(1.0), DVec3::ZERO, DVec3::Z, 0.0, f64::NAN).is_err());
 }
+
+/// Interreflections of a luminaire's light in a 6 × 4 × 3 m room (floor 0.3, walls 0.6, ceiling
+/// 0.8), lit by a downlight off-centre, against the independent dense solver
+/// (`radiosity::validation::dense`: uniform meshes of 0.5 and 0.25 m, each patch's direct light by
+/// an 8 × 8 midpoint rule, Richardson): every surface's mean within 1% of the largest at the
+/// default settings.
+#[test]
+fn room_lit_by_a_luminaire_matches_the_dense_reference() {
+    use radiosity::validation::dense;
+    let (lo, hi) = (DVec3::ZERO, DVec3::new(6.0, 4.0, 3.0));
+    let mut b = SceneBuilder::new(Path::new("lit-room"), "lit-room");
+    let walls = b.group("walls");
+    for (name, q) in box_faces(lo, hi, true) {
+        let n = (q[1] - q[0]).cross(q[2] - q[0]).normalize();
+        let rho = if n.z > 0.5 { 0.3 } else if n.z < -0.5 { 0.8 } else { 0.6 };
+        let m = b.material(Material::diffuse(name, [rho; 3])).unwrap();
+        b.face(&q, m, walls, 0).unwrap();
+    }
+    let lum = down("downlight", lambert(1000.0), DVec3::new(1.5, 1.2, 2.6));
+    let scene = with_luminaires(b.finish(), vec![lum.clone()]);
+    let (rho, e) = dense::materials(&scene);
+    let direct = |x: DVec3, n: DVec3| lum.illuminance_unoccluded(x, n);
+    let coarse = dense::DenseSystem::new(&scene, 0.5).polygon_means_lit(&rho, &e, direct);
+    let fine = dense::DenseSystem::new(&scene, 0.25).polygon_means_lit(&rho, &e, direct);
+    let reference = dense::richardson(&coarse, &fine);
+    let top = reference.iter().map(|m| m[0]).fold(0.0, f64::max);
+    let spread = reference.iter().zip(&fine).map(|(r, f)| (r[0] - f[0]).abs() / top).fold(0.0, f64::max);
+    assert!(spread < 2e-3, "the reference's own Richardson correction {spread}");
+    let solved = solve(&scene);
+    let got = radiosity::output::polygon_results(&solved.hierarchy, &solved.solution);
+    let worst = got.iter().zip(&reference).map(|(g, r)| (g.b[0] - r[0]).abs() / top).fold(0.0, f64::max);
+    eprintln!("lit room: worst polygon {worst:.2e} of the largest mean; estimate {:?}", solved.error_estimate);
+    assert!(worst <= 0.01, "worst polygon off by {worst} of the largest mean");
+    if let Some(estimate) = solved.error_estimate {
+        assert!(estimate >= worst, "estimate {estimate} below the true error {worst}");
+    }
+}

@@ -464,6 +464,8 @@ mod tests {
             groups: (0..objects.len()).map(|g| format!("o{g}")).collect(),
             camera: None,
             warnings: Default::default(),
+            luminaires: Vec::new(),
+            units: Default::default(),
         }
     }
 

@@ -31,8 +31,17 @@
 //! translate = [0, 0, 0.3]         #   or translate / rotate (degrees about x, y, z) / scale,
 //! rotate = [0, 30, 77]            #   composed as translate · rotate · scale
 //! scale = 0.8
+//!
+//! units = "photometric"           # optional: lm, cd, lx (default "radiometric": W, W/m²)
+//! [[luminaire]]                   # a photometric file placed in the scene (photometric units)
+//! ies = "downlight.ies"           # or ldt = "downlight.ldt", relative to the scene file
+//! position = [2.0, 2.0, 2.9]
+//! aim = [0.0, 0.0, -1.0]          # photometric nadir (γ = 0); default −z
+//! rotate = 0.0                    # degrees about the aim, turning the C = 0 plane
+//! multiplier = 1.0
 //! ```
-//! Instances nest to any depth; a cycle, a singular transform, a missing OBJ file or a syntax error
+//! A file with luminaires or photometric units is flattened and solved as a plain scene (see
+//! [`crate::luminaire`]). Instances nest to any depth; a cycle, a singular transform, a missing OBJ file or a syntax error
 //! is reported as `file:line: reason`.
 //!
 //! # Two-sided surfaces

@@ -78,11 +78,43 @@ impl DenseSystem {
     /// returns each input polygon's area-weighted mean radiosity.
     #[must_use]
     pub fn polygon_means(&self, reflectance: &[[f64; 3]], emission: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        self.polygon_means_lit(reflectance, emission, |_, _| 0.0)
+    }
+
+    /// [`DenseSystem::polygon_means`] with a direct illuminance `direct(x, n)` (a luminaire's, in a
+    /// convex room) on top of the emission: each patch emits `E + ρ·D̄`, `D̄` its mean of `direct`
+    /// by the [`DIRECT_CELLS`]² midpoint rule.
+    #[must_use]
+    pub fn polygon_means_lit(
+        &self,
+        reflectance: &[[f64; 3]],
+        emission: &[[f64; 3]],
+        direct: impl Fn(DVec3, DVec3) -> f64 + Sync,
+    ) -> Vec<[f64; 3]> {
         let n = self.patches.len();
+        let cells = DIRECT_CELLS as f64;
+        let d: Vec<f64> = self
+            .patches
+            .par_iter()
+            .map(|p| {
+                let mut sum = 0.0;
+                let mut weight = 0.0;
+                for i in 0..DIRECT_CELLS {
+                    for j in 0..DIRECT_CELLS {
+                        let (u, v) = ((i as f64 + 0.5) / cells, (j as f64 + 0.5) / cells);
+                        // An area-preserving map of the unit square (the mesh's quads are
+                        // parallelograms; triangles are folded).
+                        sum += direct(p.poly.sample(u, v), p.normal);
+                        weight += 1.0;
+                    }
+                }
+                sum / weight
+            })
+            .collect();
         let mut means = vec![[0.0; 3]; self.n_polygons];
         for c in 0..3 {
             let rho: Vec<f64> = self.patches.iter().map(|p| reflectance[p.polygon][c]).collect();
-            let e: Vec<f64> = self.patches.iter().map(|p| emission[p.polygon][c]).collect();
+            let e: Vec<f64> = self.patches.iter().zip(&d).map(|(p, d)| emission[p.polygon][c] + reflectance[p.polygon][c] * d).collect();
             let mut b = e.clone();
             loop {
                 let next: Vec<f64> = (0..n)
@@ -108,6 +140,9 @@ impl DenseSystem {
         means
     }
 }
+
+/// Cells per side of the midpoint rule of [`DenseSystem::polygon_means_lit`].
+pub const DIRECT_CELLS: usize = 8;
 
 /// The scene's reflectance and emission per polygon.
 #[must_use]
