@@ -24,6 +24,10 @@ pub struct StatsTimes {
     /// Gathering the irradiance at calculation points (`solve --points`; absent without).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub points: Option<f64>,
+    /// Gathering the irradiance at the grids' points (`solve --grid` / `--work-plane`; absent
+    /// without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grids: Option<f64>,
 }
 
 /// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
@@ -94,6 +98,10 @@ pub struct Stats {
     /// Visibility rays cast for the calculation points (absent without `--points`; not in `rays`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub point_rays: Option<u64>,
+    /// The figures of each calculation grid, by name, on the photopic value (`solve --grid` /
+    /// `--work-plane`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grids: Option<std::collections::BTreeMap<String, crate::points::GridSummary>>,
 }
 
 /// Peak resident set size of this process (`VmHWM` on Linux).
@@ -168,6 +176,7 @@ impl Stats {
                 total,
                 runs: 1,
                 points: None,
+                grids: None,
             },
             peak_rss_bytes: peak_rss_bytes(),
             left_out: solved.left_out.clone(),
@@ -182,6 +191,7 @@ impl Stats {
             warnings: scene.warnings.clone(),
             points: None,
             point_rays: None,
+            grids: None,
         }
     }
 }
