@@ -31,6 +31,14 @@
 //! translate = [0, 0, 0.3]         #   or translate / rotate (degrees about x, y, z) / scale,
 //! rotate = [0, 30, 77]            #   composed as translate · rotate · scale
 //! scale = 0.8
+//!
+//! [[grid]]                        # optional, repeatable: calculation points (points::GridSpec)
+//! name = "work"                   #   grid_work.csv: origin + s·u + t·v, points in the centres
+//! origin = [0.5, 0.5, 0.8]        #   of cells at most `spacing` wide, half a cell in from the
+//! u = [3.0, 0.0, 0.0]             #   edges; `normal` optional (default u × v)
+//! v = [0.0, 3.0, 0.0]
+//! spacing = 0.25
+//! normal = [0.0, 0.0, 1.0]
 //! ```
 //! Instances nest to any depth; a cycle, a singular transform, a missing OBJ file or a syntax error
 //! is reported as `file:line: reason`.

@@ -147,3 +147,55 @@ fn work_plane_over_the_floor_less_the_border() {
         "--work-plane: the floor is 6 × 4 (at z = 0.1): no room inside a border zone of 2"
     );
 }
+
+const SCENE_WITH_GRIDS: &str = r#"
+[[material]]
+name = "wall"
+reflectance = 0.5
+
+[[box]]
+min = [0, 0, 0]
+max = [4, 4, 3]
+material = "wall"
+inward = true
+
+[[grid]]
+name = "work"
+origin = [0.5, 0.5, 0.8]
+u = [3.0, 0.0, 0.0]
+v = [0.0, 3.0, 0.0]
+spacing = 0.25
+normal = [0.0, 0.0, 1.0]
+
+[[grid]]
+name = "wall"
+origin = [0.0, 0.0, 0.0]
+u = [0.0, 4.0, 0.0]
+v = [0.0, 0.0, 3.0]
+spacing = 0.5
+"#;
+
+fn parse_scene(text: &str) -> Result<crate::instancing::InstancedScene, String> {
+    crate::instancing::parse(text, std::path::Path::new("scene.toml"), std::path::Path::new(".")).map_err(|e| e.to_string())
+}
+
+#[test]
+fn scene_files_carry_their_grids() {
+    let s = parse_scene(SCENE_WITH_GRIDS).unwrap();
+    assert_eq!(s.grids.len(), 2);
+    assert_eq!(s.grids[0], spec());
+    assert_eq!(s.grids[1].grid().unwrap().normal, DVec3::X);
+    // Written and read back.
+    let dir = std::env::temp_dir().join(format!("radiosity-grid-roundtrip-{}", std::process::id()));
+    let path = crate::instancing::write_scene(&s, &dir, "s").unwrap();
+    let back = crate::instancing::load(&path).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(back.grids, s.grids);
+    // Errors name the line of the grid.
+    let bad = SCENE_WITH_GRIDS.replace("spacing = 0.5", "spacing = -1");
+    assert_eq!(parse_scene(&bad).unwrap_err(), "scene.toml:20: grid `wall`: `spacing` must be positive, found -1");
+    let dup = SCENE_WITH_GRIDS.replace("name = \"wall\"\norigin", "name = \"work\"\norigin");
+    assert_eq!(parse_scene(&dup).unwrap_err(), "scene.toml:20: duplicate grid `work`");
+    let unknown = SCENE_WITH_GRIDS.replace("spacing = 0.5", "spacing = 0.5\nheight = 1");
+    assert!(parse_scene(&unknown).unwrap_err().starts_with("scene.toml:"), "{}", parse_scene(&unknown).unwrap_err());
+}
