@@ -151,7 +151,7 @@ pub fn grid_svg(grid: &Grid, values: &[f64], summary: &GridSummary, units: Units
             }
         }
         let figures = format!(
-            "Eavg {:.4} {unit}   Emin {:.4} {unit}   Emax {:.4} {unit}   U0 = Emin/Eavg {:.3}   Emin/Emax {:.3}   contours every {} {unit}",
+            "Eavg {:.4} {unit};  Emin {:.4} {unit};  Emax {:.4} {unit};  U0 = Emin/Eavg {:.3};  Emin/Emax {:.3};  contours every {} {unit}",
             summary.e_avg,
             summary.e_min,
             summary.e_max,

@@ -169,7 +169,8 @@ impl GridSpec {
         }
         let (origin, u, v) = (DVec3::from_array(self.origin), DVec3::from_array(self.u), DVec3::from_array(self.v));
         let cross = u.cross(v);
-        if !(cross.length() > DEGENERATE_SIN * u.length() * v.length()) {
+        // Finite here: u and v were checked.
+        if cross.length() <= DEGENERATE_SIN * u.length() * v.length() {
             return Err(err("`u` and `v` must be non-zero and not parallel".into()));
         }
         let normal = match self.normal {
