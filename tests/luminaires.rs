@@ -212,7 +212,13 @@ fn room_lit_by_a_luminaire_matches_the_dense_reference() {
     let walls = b.group("walls");
     for (name, q) in box_faces(lo, hi, true) {
         let n = (q[1] - q[0]).cross(q[2] - q[0]).normalize();
-        let rho = if n.z > 0.5 { 0.3 } else if n.z < -0.5 { 0.8 } else { 0.6 };
+        let rho = if n.z > 0.5 {
+            0.3
+        } else if n.z < -0.5 {
+            0.8
+        } else {
+            0.6
+        };
         let m = b.material(Material::diffuse(name, [rho; 3])).unwrap();
         b.face(&q, m, walls, 0).unwrap();
     }

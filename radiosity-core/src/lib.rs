@@ -10,6 +10,7 @@
 //! - [`solve`]: gather, push-pull, GMRES on the hierarchical operator → radiosity per element
 //! - [`output`]: `image.png`, `solution.ply`, `patches.csv`, `stats.json`
 //! - [`points`]: irradiance at calculation points, gathered from the solution → `points.csv`
+//! - [`photometry`]: luminous intensity distributions of luminaires (IES LM-63, EULUMDAT)
 #![warn(missing_docs)]
 
 pub mod analysis;

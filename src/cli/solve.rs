@@ -63,6 +63,50 @@ pub struct SolveArgs {
     /// Plain scenes only: refused for instanced scenes and `--instances auto`.
     #[arg(long, value_name = "FILE.csv")]
     pub points: Option<PathBuf>,
+    /// Calculation grid (repeatable): `name=NAME,origin=X;Y;Z,u=X;Y;Z,v=X;Y;Z,spacing=S` and
+    /// optionally `,normal=X;Y;Z` (default u × v): the parallelogram origin + s·u + t·v cut into
+    /// cells at most `spacing` wide, a point facing `normal` at each cell's centre. Writes
+    /// grid_NAME.csv (as points.csv), grid_NAME.svg (isolux plot) and the figures (e_avg, e_min,
+    /// e_max, u0, e_min/e_max) to stats.json under `grids`. Plain scenes only.
+    #[arg(long = "grid", value_name = "SPEC")]
+    pub grids: Vec<String>,
+    /// A grid named `work` this high (scene units) above the floor, facing up, over the floor's
+    /// extent less a border zone (EN 12464-1: 0.5 m). The floor: the polygons facing up (within 1°
+    /// of the --up axis) at the lowest height among them; their bounding rectangle is the extent.
+    #[arg(long, value_name = "HEIGHT")]
+    pub work_plane: Option<f64>,
+    /// The scene's up axis, for --work-plane.
+    #[arg(long, value_enum, default_value_t = Up::Z)]
+    pub up: Up,
+    /// Width of the border zone left out of --work-plane (scene units; EN 12464-1: 0.5 m).
+    #[arg(long, default_value_t = radiosity::points::grid::EN12464_BORDER_M, value_name = "WIDTH")]
+    pub work_plane_border: f64,
+    /// Largest spacing of the --work-plane points (scene units; default EN 12464-1's
+    /// 0.2·5^log10(d), d the longer side).
+    #[arg(long, value_name = "SPACING")]
+    pub work_plane_spacing: Option<f64>,
+}
+
+/// Values of `--up`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Up {
+    /// +x is up.
+    X,
+    /// +y is up.
+    Y,
+    /// +z is up.
+    Z,
+}
+
+impl Up {
+    fn axis(self) -> radiosity::points::grid::UpAxis {
+        use radiosity::points::grid::UpAxis;
+        match self {
+            Up::X => UpAxis::X,
+            Up::Y => UpAxis::Y,
+            Up::Z => UpAxis::Z,
+        }
+    }
 }
 
 /// Most solves `--time-for` times.
@@ -92,16 +136,24 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         args.level_cache_mb
     );
     let toml = args.scene.as_ref().is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")));
-    // A scene file with luminaires or photometric units is flattened and solved as a plain scene.
+    let has_grids = !args.grids.is_empty() || args.work_plane.is_some();
+    anyhow::ensure!(
+        !has_grids || args.instances == Instances::None,
+        "--grid and --work-plane apply to plain scenes, not to --instances auto"
+    );
+    // A scene file with luminaires, photometric units or grids is flattened and solved as a plain
+    // scene.
     let mut lit_scene = None;
+    let mut file_grids = Vec::new();
     if toml {
         let path = args.scene.as_ref().expect("checked above");
         let (scene, lighting) = radiosity::instancing::load_with_lighting(path)?;
-        if lighting.needs_plain_solve() {
+        if lighting.needs_plain_solve() || !scene.grids.is_empty() || has_grids {
             anyhow::ensure!(args.instances == Instances::None, "--instances auto applies to plain OBJ / MGF scenes");
             let mut plain = radiosity::instancing::flatten(&scene, &radiosity::instancing::FlattenOptions::default())?;
             plain.luminaires = lighting.luminaires;
             plain.units = lighting.units;
+            file_grids.clone_from(&scene.grids);
             lit_scene = Some(plain);
         } else {
             anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
@@ -128,10 +180,21 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     reporter.phase("loading scene");
     // The points file is read first, so that a bad row stops the command before the solve.
     let points = args.points.as_deref().map(radiosity::points::read_points).transpose()?;
+    let mut grid_specs = args.grids.iter().map(|g| radiosity::points::GridSpec::parse_arg(g)).collect::<Result<Vec<_>, _>>()?;
+    grid_specs.extend(file_grids);
     let scene = match lit_scene {
         Some(scene) => scene,
         None => load_scene(args.scene.as_ref(), args.options.common.allow_dark)?,
     };
+    if let Some(height) = args.work_plane {
+        let spec = radiosity::points::grid::work_plane(&scene, height, args.up.axis(), args.work_plane_border, args.work_plane_spacing)?;
+        grid_specs.push(spec);
+    }
+    let mut grids = Vec::with_capacity(grid_specs.len());
+    for spec in &grid_specs {
+        anyhow::ensure!(!grids.iter().any(|g: &radiosity::points::Grid| g.spec.name == spec.name), "grid `{}` given twice", spec.name);
+        grids.push(spec.grid()?);
+    }
     let load = t0.elapsed().as_secs_f64();
     let mut params = super::oracle::parse_params(&args.params)?;
     if !params.iter().any(|(k, _)| k == "eps") {
@@ -160,6 +223,16 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         let results = radiosity::points::gather(&solved, points, &config);
         (points, results, t.elapsed().as_secs_f64())
     });
+    let t_grids = Instant::now();
+    let grid_results: Vec<Vec<radiosity::points::PointIrradiance>> = grids
+        .iter()
+        .map(|g| {
+            reporter.phase(&format!("gathering at grid `{}` ({} points)", g.spec.name, g.points.len()));
+            let config = radiosity::points::PointsConfig { use_visibility: config.use_visibility, ..Default::default() };
+            radiosity::points::gather(&solved, &g.points, &config)
+        })
+        .collect();
+    let grid_seconds = t_grids.elapsed().as_secs_f64();
     reporter.phase("writing outputs");
     let t_out = Instant::now();
     let oracle_params: serde_json::Map<String, serde_json::Value> = params.iter().map(|(k, v)| (k.clone(), serde_json::json!(v))).collect();
@@ -187,6 +260,10 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         stats.points = Some(points.len());
         stats.point_rays = Some(results.iter().map(|r| r.rays).sum());
         stats.time_s.points = Some(*seconds);
+    }
+    if !grids.is_empty() {
+        stats.grids = Some(write_grids(&args.out, &grids, &grid_results)?);
+        stats.time_s.grids = Some(grid_seconds);
     }
     stats.time_s.output = t_out.elapsed().as_secs_f64();
     stats.time_s.total = t0.elapsed().as_secs_f64();
@@ -255,8 +332,45 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
     if let (Some(n), Some(seconds)) = (s.points, s.time_s.points) {
         println!("points: irradiance at {n} calculation points in {seconds:.3}s ({} rays)", s.point_rays.unwrap_or(0));
     }
+    let units = radiosity::photometry::Units::Radiometric;
+    let (column, unit) = (radiosity::points::grid::photopic_column(units), radiosity::points::grid::photopic_unit(units));
+    let mut grid_files = String::new();
+    for (name, g) in s.grids.iter().flatten() {
+        println!(
+            "grid {name}: {} points, {column} avg {:.4e} {unit}, min {:.4e}, max {:.4e}, U0 {:.3}, min/max {:.3}",
+            g.points, g.e_avg, g.e_min, g.e_max, g.u0, g.min_over_max
+        );
+        grid_files.push_str(&format!(",grid_{name}.csv,grid_{name}.svg"));
+    }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
-    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json{points}}}", out.display());
+    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json{points}{grid_files}}}", out.display());
+}
+
+/// Writes `grid_<name>.csv` and `grid_<name>.svg` for each grid (plain scenes are radiometric) and
+/// returns the figures by name.
+fn write_grids(
+    out: &std::path::Path,
+    grids: &[radiosity::points::Grid],
+    results: &[Vec<radiosity::points::PointIrradiance>],
+) -> anyhow::Result<std::collections::BTreeMap<String, radiosity::points::GridSummary>> {
+    let units = radiosity::photometry::Units::Radiometric;
+    let mut figures = std::collections::BTreeMap::new();
+    for (g, r) in grids.iter().zip(results) {
+        let name = &g.spec.name;
+        let values: Vec<f64> = r.iter().map(radiosity::points::PointIrradiance::photopic).collect();
+        let summary = radiosity::points::GridSummary::of(&values)
+            .with_context(|| format!("grid `{name}`: no point, or a value that is not finite"))?;
+        let path = out.join(format!("grid_{name}.csv"));
+        let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
+        output::write_grid_csv(&mut w, g, r, units)
+            .and_then(|()| std::io::Write::flush(&mut w))
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+        let svg = output::grid_svg(g, &values, &summary, units).with_context(|| format!("grid `{name}`: cannot draw the plot"))?;
+        let path = out.join(format!("grid_{name}.svg"));
+        std::fs::write(&path, svg).with_context(|| format!("{}: cannot write", path.display()))?;
+        let _ = figures.insert(name.clone(), summary);
+    }
+    Ok(figures)
 }
 
 /// An instanced scene (a `.toml` file, or a plain scene after `--instances auto`, whose `auto`

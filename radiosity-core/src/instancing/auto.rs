@@ -204,6 +204,7 @@ pub fn auto_instance(scene: &Scene, options: &AutoOptions) -> AutoResult {
         materials: scene.materials.clone(),
         prototypes,
         root: 0,
+        grids: Vec::new(),
     };
     AutoResult { scene: scene_out, report, flat_to_input }
 }

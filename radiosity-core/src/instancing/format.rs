@@ -204,6 +204,9 @@ struct FileSpec {
     units: Option<crate::photometry::Units>,
     #[serde(default)]
     luminaire: Vec<Spanned<LuminaireSpec>>,
+    /// `[[grid]]`: calculation grids.
+    #[serde(default)]
+    grid: Vec<Spanned<crate::points::GridSpec>>,
 }
 
 /// Reads a scene file with instances. Prototype OBJ paths are relative to the file's folder.
@@ -293,8 +296,18 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
             (prototypes.len() - 1) as PrototypeId
         }
     };
+    let mut grids: Vec<crate::points::GridSpec> = Vec::with_capacity(spec.grid.len());
+    for g in &spec.grid {
+        let line = line_of(g.span().start);
+        let gs = g.get_ref();
+        gs.validate().map_err(|e| InstancingError::at(path, line, e.to_string()))?;
+        if grids.iter().any(|other| other.name == gs.name) {
+            return Err(InstancingError::at(path, line, format!("duplicate grid `{}`", gs.name)));
+        }
+        grids.push(gs.clone());
+    }
     let name = spec.name.unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
-    let scene = InstancedScene { name, path: path.to_owned(), materials, prototypes, root };
+    let scene = InstancedScene { name, path: path.to_owned(), materials, prototypes, root, grids };
     scene.validate()?;
     let units = spec.units.unwrap_or_default();
     let mut luminaires = Vec::with_capacity(spec.luminaire.len());

@@ -39,6 +39,13 @@
 //! aim = [0.0, 0.0, -1.0]          # photometric nadir (γ = 0); default −z
 //! rotate = 0.0                    # degrees about the aim, turning the C = 0 plane
 //! multiplier = 1.0
+//! [[grid]]                        # optional, repeatable: calculation points (points::GridSpec)
+//! name = "work"                   #   grid_work.csv: origin + s·u + t·v, points in the centres
+//! origin = [0.5, 0.5, 0.8]        #   of cells at most `spacing` wide, half a cell in from the
+//! u = [3.0, 0.0, 0.0]             #   edges; `normal` optional (default u × v)
+//! v = [0.0, 3.0, 0.0]
+//! spacing = 0.25
+//! normal = [0.0, 0.0, 1.0]
 //! ```
 //! A file with luminaires or photometric units is flattened and solved as a plain scene (see
 //! [`crate::luminaire`]). Instances nest to any depth; a cycle, a singular transform, a missing OBJ file or a syntax error

@@ -174,6 +174,8 @@ pub struct InstancedScene {
     pub prototypes: Vec<Prototype>,
     /// The prototype that is the scene.
     pub root: PrototypeId,
+    /// Calculation grids of the scene file (`[[grid]]`), validated, names unique.
+    pub grids: Vec<crate::points::GridSpec>,
 }
 
 impl InstancedScene {

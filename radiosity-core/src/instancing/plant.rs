@@ -114,6 +114,7 @@ impl PlantLibrary {
             materials: vec![Material::diffuse(BARK, [0.32, 0.27, 0.22]), leaf, Material::diffuse(GROUND, [0.25, 0.22, 0.18]), light],
             prototypes: Vec::new(),
             root: 0,
+            grids: Vec::new(),
         };
         PlantLibrary { scene, params, seed, by_key: HashMap::new() }
     }

@@ -15,6 +15,8 @@ struct OutFile {
     root: String,
     material: Vec<MaterialSpec>,
     prototype: Vec<OutPrototype>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    grid: Vec<crate::points::GridSpec>,
 }
 
 #[derive(Serialize)]
@@ -64,7 +66,8 @@ pub fn write_scene(scene: &InstancedScene, dir: &Path, stem: &str) -> Result<Pat
             .collect();
         prototype.push(OutPrototype { name: name.clone(), obj, instance });
     }
-    let out = OutFile { name: scene.name.clone(), root: names[scene.root as usize].clone(), material, prototype };
+    let out =
+        OutFile { name: scene.name.clone(), root: names[scene.root as usize].clone(), material, prototype, grid: scene.grids.clone() };
     let text = toml::to_string(&out)
         .map_err(|e| InstancingError::at(&dir.join(format!("{stem}.toml")), 0, format!("cannot encode scene: {e}")))?;
     let path = dir.join(format!("{stem}.toml"));

@@ -1,8 +1,9 @@
 //! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `solution.ply`, `patches.csv`,
-//! `stats.json`, and `points.csv` with calculation points (names and columns are relied on by other
+//! `stats.json`, `points.csv` with calculation points, and `grid_<name>.csv` / `.svg` with grids (names and columns are relied on by other
 //! tools: see DESIGN.md).
 
 mod csv;
+mod grid;
 mod ply;
 mod points;
 mod render;
@@ -11,6 +12,7 @@ mod stats;
 mod write;
 
 pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
+pub use grid::{SVG_WIDTH, TARGET_CONTOUR_LEVELS, contour_levels, grid_svg, write_grid_csv};
 pub use ply::write_ply;
 pub use points::{write_points_csv, write_points_csv_in};
 pub use render::{RenderConfig, ToneMap, render, write_png};

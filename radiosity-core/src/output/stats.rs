@@ -24,6 +24,10 @@ pub struct StatsTimes {
     /// Gathering the irradiance at calculation points (`solve --points`; absent without).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub points: Option<f64>,
+    /// Gathering the irradiance at the grids' points (`solve --grid` / `--work-plane`; absent
+    /// without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grids: Option<f64>,
 }
 
 /// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
@@ -100,6 +104,10 @@ pub struct Stats {
     /// The luminaires (photometric scenes; absent without).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub luminaires: Vec<LuminaireStats>,
+    /// The figures of each calculation grid, by name, on the photopic value (`solve --grid` /
+    /// `--work-plane`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grids: Option<std::collections::BTreeMap<String, crate::points::GridSummary>>,
 }
 
 /// One luminaire in `stats.json`.
@@ -188,6 +196,7 @@ impl Stats {
                 total,
                 runs: 1,
                 points: None,
+                grids: None,
             },
             peak_rss_bytes: peak_rss_bytes(),
             left_out: solved.left_out.clone(),
@@ -212,6 +221,7 @@ impl Stats {
                     declared_lm: l.photometry.declared_lumens.map(|d| d * l.multiplier),
                 })
                 .collect(),
+            grids: None,
         }
     }
 }

@@ -9,12 +9,14 @@
 //! `points.csv`.
 
 mod gather;
+pub mod grid;
 mod read;
 
 pub use gather::{
     MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET, SAMPLE_SHIFT, SHADOW_DEPTH,
     SHADOW_EDGE_REL_ERROR, UNIFORM_MAX_SUBTENSE, gather,
 };
+pub use grid::{Grid, GridError, GridSpec, GridSummary};
 pub use read::{PointsError, parse_points, read_points};
 
 use crate::geom::DVec3;
