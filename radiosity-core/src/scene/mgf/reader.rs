@@ -638,7 +638,12 @@ impl Reader {
         let here = self.current_path();
         // Relative to the including file; `./` components dropped so that messages read cleanly.
         let path: PathBuf = here.parent().unwrap_or(Path::new("")).join(&**name).components().filter(|c| *c != Component::CurDir).collect();
-        let src = self.open(&path, None)?;
+        let line = e.line;
+        let src = self.open(&path, None).map_err(|err| match err {
+            // Named at the `i` line, with the reason, so the message says where the include is.
+            SceneError::Io { path, source } => self.parse_err(line, format!("cannot read included file `{}`: {source}", path.display())),
+            other => other,
+        })?;
         if let Some(pos) = self.files.iter().position(|f| f.key == src.key) {
             let chain: Vec<String> = self.files[pos..].iter().chain([&src]).map(|f| f.path.display().to_string()).collect();
             return Err(self.parse_err(e.line, format!("include cycle: {}", chain.join(" -> "))));

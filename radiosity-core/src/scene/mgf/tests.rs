@@ -104,8 +104,9 @@ fn missing_include_names_the_file() {
     let main = dir.join("main.mgf");
     std::fs::write(&main, "i nowhere/missing.mgf\n").unwrap();
     let err = load(&main).unwrap_err();
-    assert!(matches!(&err, SceneError::Io { path, .. } if path.ends_with("nowhere/missing.mgf")), "{err}");
-    assert!(err.to_string().contains("missing.mgf"), "{err}");
+    // Named at the `i` line of the including file (issue 17: errors name the file that was read).
+    assert!(matches!(&err, SceneError::Parse { path, line: 1, .. } if path == &main), "{err}");
+    assert!(err.to_string().contains("cannot read included file") && err.to_string().contains("nowhere/missing.mgf"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
