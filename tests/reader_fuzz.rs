@@ -23,7 +23,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// Mutated inputs per seed file (every target has 1 or 2 seeds); `RADIOSITY_FUZZ_CASES=N` runs N
-/// instead, and `RADIOSITY_FUZZ_SEED=N` starts the generator elsewhere, for longer hunts.
+/// instead, `RADIOSITY_FUZZ_SEED=N` starts the generator elsewhere, `RADIOSITY_FUZZ_ONLY=NAME`
+/// runs one reader and `RADIOSITY_FUZZ_TRACE=1` prints each case and its input before running it (to find an
+/// input that crashes the process), for longer hunts.
 const CASES_PER_SEED: u64 = 2500;
 /// An input that takes longer than this is a failure (a reader that hangs is as bad as a panic).
 const SLOW_INPUT: Duration = Duration::from_secs(2);
@@ -446,6 +448,7 @@ fn guarded(t: &Target, input: &str) -> Result<Result<(), String>, ()> {
 fn run_target(t: &Target, base_seed: u64) -> Tally {
     quiet_panics();
     let mut tally = Tally::default();
+    let trace = std::env::var_os("RADIOSITY_FUZZ_TRACE").is_some();
     for (s, seed) in t.seeds.iter().enumerate() {
         // The seed itself must load: the mutations start from valid input.
         match guarded(t, seed) {
@@ -459,6 +462,9 @@ fn run_target(t: &Target, base_seed: u64) -> Tally {
             let input = mutate(&mut rng, seed, t.keywords);
             tally.inputs += 1;
             let t0 = Instant::now();
+            if trace {
+                eprintln!("{} seed {s} case {case}\n{input}", t.name);
+            }
             let result = guarded(t, &input);
             let elapsed = t0.elapsed();
             let describe = |what: String| format!("{} seed {s} case {case} (rng {case_seed:#x}): {what}\n--- input ---\n{input}\n---", t.name);
@@ -485,7 +491,10 @@ fn run_target(t: &Target, base_seed: u64) -> Tally {
 #[test]
 fn readers_never_panic_on_mutated_input() {
     let t0 = Instant::now();
-    let targets = targets();
+    let mut targets = targets();
+    if let Ok(only) = std::env::var("RADIOSITY_FUZZ_ONLY") {
+        targets.retain(|t| t.name == only);
+    }
     let tallies: Vec<(Tally, Duration)> = std::thread::scope(|scope| {
         let handles: Vec<_> = targets
             .iter()

@@ -177,11 +177,12 @@ impl Reader {
     fn run(&mut self, src: Rc<Source>, include_xf: Option<(XfSpec, usize)>) -> Result<(), SceneError> {
         let run = self.n_runs;
         self.n_runs += 1;
-        self.files.push(src.clone());
         let has_include_frame = include_xf.is_some();
         if let Some((spec, line)) = include_xf {
-            self.push_xf(spec, run, 0, true, line);
+            // Before the file is pushed: an error names the including file's `i` line.
+            self.push_xf(spec, run, 0, true, line)?;
         }
+        self.files.push(src.clone());
         let own_base = self.xf.len();
         let objects_base = self.objects.len();
         loop {
@@ -572,7 +573,7 @@ impl Reader {
     fn xf(&mut self, e: &Entity, run: usize, next: usize) -> Result<Option<usize>, SceneError> {
         if e.words.len() > 1 {
             let spec = XfSpec::parse(&e.words[1..]).map_err(|m| self.parse_err(e.line, m))?;
-            self.push_xf(spec, run, next, false, e.line);
+            self.push_xf(spec, run, next, false, e.line)?;
             return Ok(None);
         }
         match self.xf.last() {
@@ -587,7 +588,11 @@ impl Reader {
         Ok(None)
     }
 
-    fn push_xf(&mut self, spec: XfSpec, run: usize, resume: usize, include: bool, line: usize) {
+    fn push_xf(&mut self, spec: XfSpec, run: usize, resume: usize, include: bool, line: usize) -> Result<(), SceneError> {
+        let mut sizes = self.xf.iter().flat_map(|f| &f.spec.array_sizes).chain(&spec.array_sizes);
+        if sizes.try_fold(1usize, |acc, &n| acc.checked_mul(n)).is_none_or(|n| n > xform::MAX_INSTANCES) {
+            return Err(self.parse_err(line, format!("array transform makes over {} instances (counting enclosing arrays)", xform::MAX_INSTANCES)));
+        }
         let parent = self.xf.last().map_or(DAffine3::IDENTITY, |f| f.to_world);
         let idx = vec![0; spec.array_sizes.len()];
         let objects_base = (!idx.is_empty()).then_some(self.objects.len());
@@ -595,6 +600,7 @@ impl Reader {
         frame.update();
         self.xf.push(frame);
         self.push_instance_name();
+        Ok(())
     }
 
     /// Moves the innermost transform to its next array instance; false when it has none left.
