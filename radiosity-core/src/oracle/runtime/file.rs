@@ -188,11 +188,7 @@ fn toml_reason(e: &toml::de::Error) -> String {
 
 fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFileError> {
     let file: FileGraph = toml::from_str(text).map_err(|e| GraphFileError {
-        errors: vec![Located {
-            path: path.to_owned(),
-            line: e.span().map(|s| line_of(text, s.start)),
-            message: toml_reason(&e),
-        }],
+        errors: vec![Located { path: path.to_owned(), line: e.span().map(|s| line_of(text, s.start)), message: toml_reason(&e) }],
     })?;
     let mut errors = Vec::new();
     let at = |span: std::ops::Range<usize>| line_of(text, span.start);

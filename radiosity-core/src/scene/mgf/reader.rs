@@ -591,7 +591,9 @@ impl Reader {
     fn push_xf(&mut self, spec: XfSpec, run: usize, resume: usize, include: bool, line: usize) -> Result<(), SceneError> {
         let mut sizes = self.xf.iter().flat_map(|f| &f.spec.array_sizes).chain(&spec.array_sizes);
         if sizes.try_fold(1usize, |acc, &n| acc.checked_mul(n)).is_none_or(|n| n > xform::MAX_INSTANCES) {
-            return Err(self.parse_err(line, format!("array transform makes over {} instances (counting enclosing arrays)", xform::MAX_INSTANCES)));
+            return Err(
+                self.parse_err(line, format!("array transform makes over {} instances (counting enclosing arrays)", xform::MAX_INSTANCES))
+            );
         }
         let parent = self.xf.last().map_or(DAffine3::IDENTITY, |f| f.to_world);
         let idx = vec![0; spec.array_sizes.len()];
