@@ -171,9 +171,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
     if let Some((points, results, seconds)) = &gathered {
         let path = args.out.join("points.csv");
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
-        output::write_points_csv(&mut w, points, results)
-            .and_then(|()| std::io::Write::flush(&mut w))
+        output::atomic::write_file(&path, |w| output::write_points_csv(w, points, results))
             .with_context(|| format!("{}: cannot write", path.display()))?;
         stats.points = Some(points.len());
         stats.point_rays = Some(results.iter().map(|r| r.rays).sum());
@@ -285,7 +283,7 @@ fn solve_instanced(
         serde_json::json!({ "solve": stats.seconds, "output": t_out.elapsed().as_secs_f64(), "total": t0.elapsed().as_secs_f64() });
     doc["peak_rss_bytes"] = serde_json::json!(output::peak_rss_bytes());
     let stats_path = args.out.join("stats.json");
-    std::fs::write(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
+    output::atomic::write_bytes(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
         .with_context(|| format!("{}: cannot write", stats_path.display()))?;
     if !args.quiet {
         println!(

@@ -1,8 +1,10 @@
-//! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `solution.ply`, `patches.csv`,
+//! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `solution.ply`, `solution.glb`, `patches.csv`,
 //! `stats.json`, and `points.csv` with calculation points (names and columns are relied on by other
 //! tools: see DESIGN.md).
 
+pub mod atomic;
 mod csv;
+mod glb;
 mod ply;
 mod points;
 mod render;
@@ -11,6 +13,8 @@ mod stats;
 mod write;
 
 pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
+pub use glb::{GLB_RADIOSITY_ATTRIBUTE, GlbLayout, write_glb};
+pub(crate) use glb::{push_f32s, push_fan};
 pub use ply::write_ply;
 pub use points::write_points_csv;
 pub use render::{RenderConfig, ToneMap, render, write_png};
