@@ -240,12 +240,12 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         println!("points: irradiance at {n} calculation points in {seconds:.3}s ({} rays)", s.point_rays.unwrap_or(0));
     }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
-    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json{points}}}", out.display());
+    println!("wrote {}/{{image.png,solution.ply,solution.glb,patches.csv,stats.json{points}}}", out.display());
 }
 
 /// An instanced scene (a `.toml` file, or a plain scene after `--instances auto`, whose `auto`
 /// report goes to `stats.json`): solved depth-first, one instance open at a time, finished polygons
-/// streamed to `patches.csv` and a spool from which `solution.ply` and `image.png` are written at
+/// streamed to `patches.csv` and a spool from which `solution.ply`, `solution.glb` and `image.png` are written at
 /// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
 fn solve_instanced(
     args: &SolveArgs,
@@ -295,7 +295,11 @@ fn solve_instanced(
             t0.elapsed().as_secs_f64(),
             output::peak_rss_bytes().map_or("n/a".to_string(), |b| format!("{:.1} MB", b as f64 / 1e6))
         );
-        let files = if args.no_image { "solution.ply,patches.csv,stats.json" } else { "image.png,solution.ply,patches.csv,stats.json" };
+        let files = if args.no_image {
+            "solution.ply,solution.glb,patches.csv,stats.json"
+        } else {
+            "image.png,solution.ply,solution.glb,patches.csv,stats.json"
+        };
         println!("wrote {}/{{{files}}}", args.out.display());
     }
     Ok(())
