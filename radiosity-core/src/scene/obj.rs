@@ -214,3 +214,31 @@ fn prescan_mtl(text: &str, path: &Path) -> Result<(), SceneError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 17: `tobj` 4.0.5 panics on `Ke` with fewer than three numbers (`parse_float3` unwraps).
+    /// The pre-scan rejects the line first; were it to miss one, `contain` turns the panic into
+    /// the error's reason.
+    #[test]
+    fn short_ke_is_caught_before_tobj_and_contained_inside_it() {
+        let mtl = "newmtl lamp\nKd 0.5 0.5 0.5\nKe 10 10\n";
+        let contained = contain(|| tobj::load_mtl_buf(&mut mtl.as_bytes()).map(drop));
+        let reason = contained.expect_err("tobj 4.0.5 panics on a short Ke");
+        assert!(reason.contains("unwrap"), "{reason}");
+        let e = prescan_mtl(mtl, Path::new("room.mtl")).expect_err("pre-scan");
+        assert_eq!(e.to_string(), "room.mtl:3: `Ke` needs 3 numbers, found 2");
+        assert!(prescan_mtl("newmtl a\nKd 1 1 1 # grey\nillum 2\nNs 10\nmap_Kd tex.png\n", Path::new("ok.mtl")).is_ok());
+        for (line, reason) in [
+            ("Kd 0.5 x 0.5", "`Kd` value `x` is not a number"),
+            ("Ns", "`Ns` needs a number, found 0"),
+            ("illum 300", "`illum` value `300` is not an illumination model (0 to 255)"),
+            ("newmtl", "`newmtl` needs a name"),
+        ] {
+            let e = prescan_mtl(&format!("# bad\n{line}\n"), Path::new("bad.mtl")).expect_err(line);
+            assert_eq!(e.to_string(), format!("bad.mtl:2: {reason}"));
+        }
+    }
+}
