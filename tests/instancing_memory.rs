@@ -36,7 +36,7 @@ fn forest_of_1_2_million_polygons_solves_within_49_mb() {
         stats["time_s"]["total"].as_f64().unwrap_or(f64::NAN)
     );
     assert!(peak <= PEAK_RSS_BOUND_BYTES, "peak RSS {:.1} MB exceeds {:.0} MB", peak as f64 / 1e6, PEAK_RSS_BOUND_BYTES as f64 / 1e6);
-    for file in ["solution.ply", "patches.csv", "image.png"] {
+    for file in ["solution.ply", "solution.glb", "patches.csv", "image.png"] {
         assert!(dir.path().join("out").join(file).metadata().unwrap().len() > 0, "{file} is empty");
     }
 }

@@ -181,6 +181,21 @@ fn streamed_outputs_hold_every_polygon_and_leaf() {
     assert_eq!((img.width(), img.height()), (64, 48));
     assert!(img.pixels().any(|p| p.0.iter().any(|&c| c > 0)), "image is black");
     assert!(!dir.path().join("solution.spool").exists());
+    // solution.glb: the PLY's vertices as triangle fans (issue 17), and no temporary file left.
+    let glb = std::fs::read(dir.path().join("solution.glb")).unwrap();
+    let gltf = gltf::Gltf::from_slice(&glb).unwrap();
+    let blob = gltf.blob.clone().unwrap();
+    let prim = gltf.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = prim.reader(|_| Some(&blob));
+    assert_eq!(reader.read_positions().unwrap().count() as u64, n_vertices);
+    assert_eq!(reader.read_colors(0).unwrap().into_rgb_f32().count() as u64, n_vertices);
+    assert_eq!(reader.read_indices().unwrap().into_u32().count() as u64, 3 * (n_vertices - 2 * n_faces));
+    let hidden: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "temporary files left: {hidden:?}");
 }
 
 /// Reused vs freshly refined levels (fractions of the largest radiosity): the two differ where a

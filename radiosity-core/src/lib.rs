@@ -8,7 +8,7 @@
 //! - [`visibility`]: ray casting against a BVH of the input triangles
 //! - [`refine`]: the oracle decides per link: link here or subdivide → links
 //! - [`solve`]: gather, push-pull, GMRES on the hierarchical operator → radiosity per element
-//! - [`output`]: `image.png`, `solution.ply`, `patches.csv`, `stats.json`
+//! - [`output`]: `image.png`, `solution.ply`, `solution.glb`, `patches.csv`, `stats.json`
 //! - [`points`]: irradiance at calculation points, gathered from the solution → `points.csv`
 //! - [`photometry`]: luminous intensity distributions of luminaires (IES LM-63, EULUMDAT)
 #![warn(missing_docs)]

@@ -118,7 +118,7 @@ fn write_files(out: &std::path::Path, rows: &[serde_json::Value]) -> anyhow::Res
         );
     }
     let path = out.join("accuracy.csv");
-    std::fs::write(&path, csv).with_context(|| format!("{}: cannot write", path.display()))?;
+    radiosity::output::atomic::write_bytes(&path, csv).with_context(|| format!("{}: cannot write", path.display()))?;
     // The plot: Ward's room (worst surface-class mean, as RenderPark's figures are; and worst
     // polygon mean with its estimate) beside RenderPark, and the corner rooms (worst polygon mean,
     // estimates hollow). Furnaces and CIE 5.8 are exact to 1e-5 and would only stretch the axis.
@@ -143,7 +143,7 @@ fn write_files(out: &std::path::Path, rows: &[serde_json::Value]) -> anyhow::Res
         points.push(("RenderPark ward-room (worst class)".to_string(), time, err, 0.0));
     }
     let path = out.join("accuracy.svg");
-    std::fs::write(&path, super::sweep::svg_plot("Ward's room and the corner rooms", &points))
+    radiosity::output::atomic::write_bytes(&path, super::sweep::svg_plot("Ward's room and the corner rooms", &points))
         .with_context(|| format!("{}: cannot write", path.display()))?;
     Ok(())
 }

@@ -24,7 +24,7 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Solve a scene (OBJ or MGF; the embedded Cornell box when none is given) and write
-    /// image.png, solution.ply, patches.csv and stats.json.
+    /// image.png, solution.ply, solution.glb, patches.csv and stats.json.
     Solve(solve::SolveArgs),
     /// Error against run time: solves with several oracles and thresholds, compares with a
     /// reference, writes sweep.csv and sweep.svg.

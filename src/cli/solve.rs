@@ -253,16 +253,14 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
     if let Some((points, results, seconds)) = &gathered {
         let path = args.out.join("points.csv");
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
-        output::write_points_csv_in(&mut w, points, results, scene.units)
-            .and_then(|()| std::io::Write::flush(&mut w))
+        output::atomic::write_file(&path, |w| output::write_points_csv_in(w, points, results, scene.units))
             .with_context(|| format!("{}: cannot write", path.display()))?;
         stats.points = Some(points.len());
         stats.point_rays = Some(results.iter().map(|r| r.rays).sum());
         stats.time_s.points = Some(*seconds);
     }
     if !grids.is_empty() {
-        stats.grids = Some(write_grids(&args.out, &grids, &grid_results)?);
+        stats.grids = Some(write_grids(&args.out, &grids, &grid_results, scene.units)?);
         stats.time_s.grids = Some(grid_seconds);
     }
     stats.time_s.output = t_out.elapsed().as_secs_f64();
@@ -332,7 +330,7 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
     if let (Some(n), Some(seconds)) = (s.points, s.time_s.points) {
         println!("points: irradiance at {n} calculation points in {seconds:.3}s ({} rays)", s.point_rays.unwrap_or(0));
     }
-    let units = radiosity::photometry::Units::Radiometric;
+    let units = s.units;
     let (column, unit) = (radiosity::points::grid::photopic_column(units), radiosity::points::grid::photopic_unit(units));
     let mut grid_files = String::new();
     for (name, g) in s.grids.iter().flatten() {
@@ -343,17 +341,17 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         grid_files.push_str(&format!(",grid_{name}.csv,grid_{name}.svg"));
     }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
-    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json{points}{grid_files}}}", out.display());
+    println!("wrote {}/{{image.png,solution.ply,solution.glb,patches.csv,stats.json{points}{grid_files}}}", out.display());
 }
 
-/// Writes `grid_<name>.csv` and `grid_<name>.svg` for each grid (plain scenes are radiometric) and
-/// returns the figures by name.
+/// Writes `grid_<name>.csv` and `grid_<name>.svg` for each grid in the scene's `units` and returns
+/// the figures by name.
 fn write_grids(
     out: &std::path::Path,
     grids: &[radiosity::points::Grid],
     results: &[Vec<radiosity::points::PointIrradiance>],
+    units: radiosity::photometry::Units,
 ) -> anyhow::Result<std::collections::BTreeMap<String, radiosity::points::GridSummary>> {
-    let units = radiosity::photometry::Units::Radiometric;
     let mut figures = std::collections::BTreeMap::new();
     for (g, r) in grids.iter().zip(results) {
         let name = &g.spec.name;
@@ -361,13 +359,11 @@ fn write_grids(
         let summary = radiosity::points::GridSummary::of(&values)
             .with_context(|| format!("grid `{name}`: no point, or a value that is not finite"))?;
         let path = out.join(format!("grid_{name}.csv"));
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
-        output::write_grid_csv(&mut w, g, r, units)
-            .and_then(|()| std::io::Write::flush(&mut w))
+        output::atomic::write_file(&path, |w| output::write_grid_csv(w, g, r, units))
             .with_context(|| format!("{}: cannot write", path.display()))?;
         let svg = output::grid_svg(g, &values, &summary, units).with_context(|| format!("grid `{name}`: cannot draw the plot"))?;
         let path = out.join(format!("grid_{name}.svg"));
-        std::fs::write(&path, svg).with_context(|| format!("{}: cannot write", path.display()))?;
+        output::atomic::write_bytes(&path, svg).with_context(|| format!("{}: cannot write", path.display()))?;
         let _ = figures.insert(name.clone(), summary);
     }
     Ok(figures)
@@ -375,7 +371,7 @@ fn write_grids(
 
 /// An instanced scene (a `.toml` file, or a plain scene after `--instances auto`, whose `auto`
 /// report goes to `stats.json`): solved depth-first, one instance open at a time, finished polygons
-/// streamed to `patches.csv` and a spool from which `solution.ply` and `image.png` are written at
+/// streamed to `patches.csv` and a spool from which `solution.ply`, `solution.glb` and `image.png` are written at
 /// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
 fn solve_instanced(
     args: &SolveArgs,
@@ -413,7 +409,7 @@ fn solve_instanced(
         serde_json::json!({ "solve": stats.seconds, "output": t_out.elapsed().as_secs_f64(), "total": t0.elapsed().as_secs_f64() });
     doc["peak_rss_bytes"] = serde_json::json!(output::peak_rss_bytes());
     let stats_path = args.out.join("stats.json");
-    std::fs::write(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
+    output::atomic::write_bytes(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
         .with_context(|| format!("{}: cannot write", stats_path.display()))?;
     if !args.quiet {
         println!(
@@ -425,7 +421,11 @@ fn solve_instanced(
             t0.elapsed().as_secs_f64(),
             output::peak_rss_bytes().map_or("n/a".to_string(), |b| format!("{:.1} MB", b as f64 / 1e6))
         );
-        let files = if args.no_image { "solution.ply,patches.csv,stats.json" } else { "image.png,solution.ply,patches.csv,stats.json" };
+        let files = if args.no_image {
+            "solution.ply,solution.glb,patches.csv,stats.json"
+        } else {
+            "image.png,solution.ply,solution.glb,patches.csv,stats.json"
+        };
         println!("wrote {}/{{{files}}}", args.out.display());
     }
     Ok(())

@@ -127,9 +127,10 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         }
     }
     let csv_path = args.out.join("sweep.csv");
-    std::fs::write(&csv_path, csv).with_context(|| format!("{}: cannot write", csv_path.display()))?;
+    radiosity::output::atomic::write_bytes(&csv_path, csv).with_context(|| format!("{}: cannot write", csv_path.display()))?;
     let svg_path = args.out.join("sweep.svg");
-    std::fs::write(&svg_path, svg_plot(&scene.name, &points)).with_context(|| format!("{}: cannot write", svg_path.display()))?;
+    radiosity::output::atomic::write_bytes(&svg_path, svg_plot(&scene.name, &points))
+        .with_context(|| format!("{}: cannot write", svg_path.display()))?;
     println!("wrote {} and {}", csv_path.display(), svg_path.display());
     Ok(())
 }
@@ -173,9 +174,8 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
     let oracle = oracle_by_name("bf-hand", eps)?;
     let solved = pipeline::run(scene, oracle.as_ref(), &config, &|_| {});
     let results = polygon_results(&solved.hierarchy, &solved.solution);
-    let mut w = std::io::BufWriter::new(std::fs::File::create(&path).with_context(|| format!("{}: cannot write", path.display()))?);
-    radiosity::output::write_patches_csv(&mut w, scene, &results).with_context(|| format!("{}: cannot write", path.display()))?;
-    drop(w);
+    radiosity::output::atomic::write_file(&path, |w| radiosity::output::write_patches_csv(w, scene, &results))
+        .with_context(|| format!("{}: cannot write", path.display()))?;
     Ok(results.iter().map(|r| r.b).collect())
 }
 

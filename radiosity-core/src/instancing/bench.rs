@@ -6,7 +6,7 @@ use super::InstancingError;
 use super::model::InstancedScene;
 use super::solver::{InstancedConfig, PolygonMeans, solve_full, solve_instanced};
 use crate::output::peak_rss_bytes;
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::Path;
 
 /// One measured solve.
@@ -81,8 +81,7 @@ pub fn save_means(path: &Path, means: &PolygonMeans) -> Result<(), InstancingErr
             out.extend_from_slice(&x.to_le_bytes());
         }
     }
-    let mut f = std::fs::File::create(path).map_err(|e| InstancingError::io(path, "cannot write file", e))?;
-    f.write_all(&out).map_err(|e| InstancingError::io(path, "cannot write file", e))
+    crate::output::atomic::write_bytes(path, out).map_err(|e| InstancingError::io(path, "cannot write file", e))
 }
 
 /// Reads what [`save_means`] wrote.

@@ -232,7 +232,8 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
     let line_of = |offset: usize| text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1;
     let spec: FileSpec = toml::from_str(text).map_err(|e| {
         let line = e.span().map_or(0, |s| line_of(s.start));
-        InstancingError::at(path, line, e.message().trim_end_matches('\n').replace('\n', "; "))
+        let msg = e.message().trim();
+        InstancingError::at(path, line, if msg.is_empty() { "invalid TOML".to_owned() } else { msg.replace('\n', "; ") })
     })?;
 
     // Materials, validated by the scene builder (same rules as OBJ / MGF materials).

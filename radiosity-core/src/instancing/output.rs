@@ -1,12 +1,13 @@
-//! The outputs of an instanced solve (`solution.ply`, `patches.csv`, `image.png`), written in memory
+//! The outputs of an instanced solve (`solution.ply`, `solution.glb`, `patches.csv`, `image.png`),
+//! each written atomically ([`crate::output::atomic`]), in memory
 //! that does not grow with the scene: finished polygons are streamed, `patches.csv` row by row and
 //! the leaf elements to a spool file beside the outputs; [`StreamedOutput::finish`] then reads the
-//! spool back to write the PLY (whose header needs the counts, and whose colours need the tone map of
-//! the whole solution) and to draw the image with a z-buffer, and removes the spool.
+//! spool back to write the PLY and the GLB (whose headers need the counts, and whose colours need the
+//! tone map of the whole solution) and to draw the image with a z-buffer, and removes the spool.
 //!
 //! Differences from a plain solve's outputs: `patches.csv` rows come in solve order (the `index`
 //! column is the flattened polygon's index), their `group` is the prototype that holds the polygon;
-//! the PLY and the image are flat-shaded per leaf (no smoothing across leaves, which would need the
+//! the PLY, the GLB and the image are flat-shaded per leaf (no smoothing across leaves, which would need the
 //! neighbours in memory); the image is seen from the side (looking along +y, z up: the plant
 //! generator's convention), as instanced scene files carry no camera.
 
@@ -14,7 +15,8 @@ use super::InstancingError;
 use super::model::InstancedScene;
 use super::solver::{Leaf, PolygonInfo, RadiositySink, leaf_means};
 use crate::geom::{Aabb, DVec3};
-use crate::output::{RenderConfig, ToneMap};
+use crate::output::atomic::AtomicFile;
+use crate::output::{GlbLayout, RenderConfig, ToneMap};
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
@@ -31,7 +33,8 @@ pub struct StreamedOutput {
     spool_path: PathBuf,
     spool: BufWriter<std::fs::File>,
     csv_path: PathBuf,
-    csv: BufWriter<std::fs::File>,
+    /// `patches.csv` under its temporary name until [`StreamedOutput::finish`] (`None` after).
+    csv: Option<AtomicFile>,
     prototype_names: Vec<String>,
     material_names: Vec<String>,
     emitter: Vec<bool>,
@@ -59,20 +62,17 @@ impl StreamedOutput {
     /// Creates `dir` and opens `patches.csv` and the spool in it.
     pub fn create(dir: &Path, scene: &InstancedScene) -> Result<StreamedOutput, InstancingError> {
         std::fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
-        let open = |name: &str| -> Result<(PathBuf, BufWriter<std::fs::File>), InstancingError> {
-            let path = dir.join(name);
-            let file = std::fs::File::create(&path).map_err(|e| io_err(&path, e))?;
-            Ok((path, BufWriter::new(file)))
-        };
-        let (spool_path, spool) = open("solution.spool")?;
-        let (csv_path, mut csv) = open("patches.csv")?;
+        let spool_path = dir.join("solution.spool");
+        let spool = BufWriter::new(std::fs::File::create(&spool_path).map_err(|e| io_err(&spool_path, e))?);
+        let csv_path = dir.join("patches.csv");
+        let mut csv = AtomicFile::create(&csv_path).map_err(|e| io_err(&csv_path, e))?;
         writeln!(csv, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b,units").map_err(|e| io_err(&csv_path, e))?;
         Ok(StreamedOutput {
             dir: dir.to_owned(),
             spool_path,
             spool,
             csv_path,
-            csv,
+            csv: Some(csv),
             prototype_names: scene.prototypes.iter().map(|p| p.name.clone()).collect(),
             material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
             emitter: scene.materials.iter().map(crate::scene::Material::is_emitter).collect(),
@@ -104,19 +104,22 @@ impl StreamedOutput {
         ToneMap::from_levels(p95, self.max_b)
     }
 
-    /// Writes `solution.ply` and, with `render`, `image.png` from the spool, then removes it.
+    /// Renames `patches.csv` to its final name, writes `solution.ply`, `solution.glb` and, with
+    /// `render`, `image.png` from the spool, then removes it (the spool is removed on failure too).
     pub fn finish(mut self, render: Option<&RenderConfig>) -> Result<StreamedSummary, InstancingError> {
-        self.csv.flush().map_err(|e| io_err(&self.csv_path, e))?;
+        if let Some(csv) = self.csv.take() {
+            csv.commit().map_err(|e| io_err(&self.csv_path, e))?;
+        }
         self.spool.flush().map_err(|e| io_err(&self.spool_path, e))?;
         let tone = self.tone();
         self.write_ply(&tone)?;
+        self.write_glb(&tone)?;
         if let Some(render) = render {
             let rgb = self.render(&tone, render)?;
             let png = self.dir.join("image.png");
             crate::output::write_png(&png, &rgb, render.width, render.height)
                 .map_err(|e| InstancingError::io(&png, "cannot write image", std::io::Error::other(e)))?;
         }
-        let _ = std::fs::remove_file(&self.spool_path);
         Ok(StreamedSummary { leaves: self.leaves, white: tone.white })
     }
 
@@ -144,8 +147,7 @@ impl StreamedOutput {
     /// Binary PLY with the properties of the plain solve's `solution.ply` (flat per leaf).
     fn write_ply(&self, tone: &ToneMap) -> Result<(), InstancingError> {
         let path = self.dir.join("solution.ply");
-        let file = std::fs::File::create(&path).map_err(|e| io_err(&path, e))?;
-        let mut w = BufWriter::new(file);
+        let mut w = AtomicFile::create(&path).map_err(|e| io_err(&path, e))?;
         write!(
             w,
             "ply\nformat binary_little_endian 1.0\ncomment radiosity solution (instanced, flat per leaf), radiosity in W/m2\n\
@@ -183,7 +185,45 @@ impl StreamedOutput {
                 result = w.write_all(&rec[..1 + 4 * vs.len()]);
             }
         })?;
-        result.and_then(|()| w.flush()).map_err(|e| io_err(&path, e))
+        result.and_then(|()| w.commit()).map_err(|e| io_err(&path, e))
+    }
+
+    /// `solution.glb` with the layout of the plain solve's ([`crate::output::write_glb`]), flat per
+    /// leaf: four passes over the spool (positions, colours, radiosity, indices).
+    fn write_glb(&self, tone: &ToneMap) -> Result<(), InstancingError> {
+        let path = self.dir.join("solution.glb");
+        let mut w = AtomicFile::create(&path).map_err(|e| io_err(&path, e))?;
+        let (min, max) = if self.bounds.is_empty() {
+            ([0.0; 3], [0.0; 3])
+        } else {
+            // Rounding to f32 is monotonic, so the rounded bounds bound the rounded vertices.
+            let (a, b) = (self.bounds.min, self.bounds.max);
+            ([a.x as f32, a.y as f32, a.z as f32], [b.x as f32, b.y as f32, b.z as f32])
+        };
+        let layout = GlbLayout { n_vertices: self.vertices, n_triangles: self.vertices.saturating_sub(2 * self.leaves), min, max };
+        let header = layout.header().map_err(|e| io_err(&path, e))?;
+        w.write_all(&header).map_err(|e| io_err(&path, e))?;
+        let mut result = Ok(());
+        let mut buf = Vec::with_capacity(64);
+        let mut next = 0u32;
+        for pass in 0..4 {
+            self.read_spool(&mut |vs, b| {
+                buf.clear();
+                match pass {
+                    0 => vs.iter().for_each(|v| crate::output::push_f32s(&mut buf, [v.x as f32, v.y as f32, v.z as f32])),
+                    1 => vs.iter().for_each(|_| crate::output::push_f32s(&mut buf, tone.linear(b).map(|x| x as f32))),
+                    2 => vs.iter().for_each(|_| crate::output::push_f32s(&mut buf, b.map(|x| x as f32))),
+                    _ => {
+                        crate::output::push_fan(&mut buf, next, vs.len());
+                        next += vs.len() as u32;
+                    }
+                }
+                if result.is_ok() {
+                    result = w.write_all(&buf);
+                }
+            })?;
+        }
+        result.and_then(|()| w.commit()).map_err(|e| io_err(&path, e))
     }
 
     /// Draws the spooled leaves with a z-buffer at `samples`² supersampling; RGB bytes, rows from
@@ -236,6 +276,14 @@ impl StreamedOutput {
     }
 }
 
+impl Drop for StreamedOutput {
+    /// Removes the spool, whether the solve finished or not; an unfinished `patches.csv` is removed
+    /// by its [`AtomicFile`].
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.spool_path);
+    }
+}
+
 impl RadiositySink for StreamedOutput {
     fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError> {
         let (area, b, h) = leaf_means(leaves);
@@ -266,8 +314,9 @@ impl RadiositySink for StreamedOutput {
         }
         let group = self.prototype_names.get(info.prototype as usize).map_or("", String::as_str);
         let material = self.material_names.get(info.material as usize).map_or("", String::as_str);
+        let Some(csv) = self.csv.as_mut() else { return Err(io_err(&self.csv_path, std::io::Error::other("already finished"))) };
         writeln!(
-            self.csv,
+            csv,
             "{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},W/m2",
             info.flat_index,
             crate::output::csv_field(group),

@@ -545,10 +545,8 @@ impl PropertyCache {
         let flat = flatten_prototype(scene, id, &Transform::IDENTITY, &FlattenOptions { two_sided_pairs: false })?;
         let props = compute_flat(&flat, name, key, config);
         std::fs::create_dir_all(&self.dir).map_err(|e| InstancingError::io(&self.dir, "cannot create folder", e))?;
-        let tmp = path.with_extension("json.tmp");
         let text = serde_json::to_string(&props).map_err(|e| InstancingError::Cache { path: path.clone(), msg: e.to_string() })?;
-        std::fs::write(&tmp, text).map_err(|e| InstancingError::io(&tmp, "cannot write file", e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| InstancingError::io(&path, "cannot write file", e))?;
+        crate::output::atomic::write_bytes(&path, text).map_err(|e| InstancingError::io(&path, "cannot write file", e))?;
         Ok((props, CacheOutcome::Computed))
     }
 }

@@ -52,7 +52,8 @@ pub fn write_scene(scene: &InstancedScene, dir: &Path, stem: &str) -> Result<Pat
         } else {
             let file = format!("{stem}_{}.obj", sanitize(name));
             let path = dir.join(&file);
-            std::fs::write(&path, obj_text(scene, p)).map_err(|e| InstancingError::io(&path, "cannot write file", e))?;
+            crate::output::atomic::write_bytes(&path, obj_text(scene, p))
+                .map_err(|e| InstancingError::io(&path, "cannot write file", e))?;
             Some(file)
         };
         let instance = p
@@ -72,7 +73,7 @@ pub fn write_scene(scene: &InstancedScene, dir: &Path, stem: &str) -> Result<Pat
         .map_err(|e| InstancingError::at(&dir.join(format!("{stem}.toml")), 0, format!("cannot encode scene: {e}")))?;
     let path = dir.join(format!("{stem}.toml"));
     let header = "# Scene with instances (radiosity instancing format): materials, prototypes (OBJ + instances), root.\n";
-    std::fs::write(&path, format!("{header}{text}")).map_err(|e| InstancingError::io(&path, "cannot write file", e))?;
+    crate::output::atomic::write_bytes(&path, format!("{header}{text}")).map_err(|e| InstancingError::io(&path, "cannot write file", e))?;
     Ok(path)
 }
 

@@ -61,11 +61,20 @@ impl ToneMap {
         ToneMap { white: if white > 0.0 { white } else { 1.0 } }
     }
 
-    /// Display bytes of a radiosity.
+    /// Linear display value of a radiosity, before the sRGB encoding: `b / white` clamped to
+    /// [0, 1] (NaN gives 0).
     #[must_use]
-    pub fn map(&self, b: [f64; 3]) -> [u8; 3] {
+    pub fn linear(&self, b: [f64; 3]) -> [f64; 3] {
         b.map(|v| {
             let x = (v / self.white).clamp(0.0, 1.0);
+            if x.is_nan() { 0.0 } else { x }
+        })
+    }
+
+    /// Display bytes of a radiosity: the sRGB encoding of [`ToneMap::linear`].
+    #[must_use]
+    pub fn map(&self, b: [f64; 3]) -> [u8; 3] {
+        self.linear(b).map(|x| {
             let srgb = if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
             (srgb * 255.0 + 0.5) as u8
         })
@@ -135,7 +144,9 @@ fn shade(h: &Hierarchy, caster: &RayCaster, corners: &CornerValues, origin: DVec
     corners.interpolate(leaf, kind, ls, lt).unwrap_or([0.0; 3])
 }
 
-/// Encodes RGB bytes as PNG.
+/// Encodes RGB bytes as PNG into `path`, atomically ([`super::atomic::write_file`]).
 pub fn write_png(path: &std::path::Path, rgb: &[u8], width: u32, height: u32) -> Result<(), image::ImageError> {
-    image::save_buffer(path, rgb, width, height, image::ExtendedColorType::Rgb8)
+    super::atomic::write_file(path, |w| {
+        image::write_buffer_with_format(w, rgb, width, height, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
+    })
 }

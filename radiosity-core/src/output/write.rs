@@ -1,9 +1,9 @@
-//! Writes the four output files of a solve into a directory.
+//! Writes the output files of a solve into a directory, each atomically ([`super::atomic`]).
 
-use super::{CornerValues, RenderConfig, Stats, ToneMap, polygon_results, render, write_patches_csv, write_ply, write_png};
+use super::atomic::AtomicFile;
+use super::{CornerValues, RenderConfig, Stats, ToneMap, polygon_results, render, write_glb, write_patches_csv, write_ply, write_png};
 use crate::pipeline::Solved;
 use crate::scene::Scene;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 /// A file that could not be written.
@@ -31,29 +31,26 @@ impl Default for OutputConfig {
     }
 }
 
-fn create(path: &Path) -> Result<BufWriter<std::fs::File>, OutputError> {
-    std::fs::File::create(path).map(BufWriter::new).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
+/// Writes `path` atomically with `write` ([`super::atomic::write_file`]); errors name the file.
+fn write_atomic(path: &Path, write: impl FnOnce(&mut AtomicFile) -> std::io::Result<()>) -> Result<(), OutputError> {
+    super::atomic::write_file(path, write).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
 }
 
-/// Writes `patches.csv`, `solution.ply` and `image.png` (unless disabled) into `dir` (created if
+/// Writes `patches.csv`, `solution.ply`, `solution.glb` and `image.png` (unless disabled) into `dir` (created if
 /// needed); `stats.json` is written by [`write_stats`] once the output time is known.
 pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &OutputConfig) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|e| OutputError { path: dir.to_path_buf(), reason: e.to_string() })?;
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |e: std::io::Error| OutputError { path, reason: e.to_string() }
-    };
     let results = polygon_results(&solved.hierarchy, &solved.solution);
     let path = dir.join("patches.csv");
-    let mut w = create(&path)?;
-    write_patches_csv(&mut w, scene, &results).and_then(|()| std::io::Write::flush(&mut w)).map_err(io(&path))?;
+    write_atomic(&path, |w| write_patches_csv(w, scene, &results))?;
 
     let per_polygon: Vec<[f64; 3]> = results.iter().map(|r| r.b).collect();
     let tone = ToneMap::from_scene(scene, &per_polygon);
     let corners = CornerValues::new(&solved.hierarchy, &solved.solution);
     let path = dir.join("solution.ply");
-    let mut w = create(&path)?;
-    write_ply(&mut w, &solved.hierarchy, &corners, &tone).and_then(|()| std::io::Write::flush(&mut w)).map_err(io(&path))?;
+    write_atomic(&path, |w| write_ply(w, &solved.hierarchy, &corners, &tone))?;
+    let path = dir.join("solution.glb");
+    write_atomic(&path, |w| write_glb(w, &solved.hierarchy, &corners, &tone))?;
 
     if config.image {
         let path = dir.join("image.png");
@@ -67,13 +64,9 @@ pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &Outpu
 
 /// Writes `stats.json` into `dir`.
 pub fn write_stats(dir: &Path, stats: &Stats) -> Result<(), OutputError> {
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |e: std::io::Error| OutputError { path, reason: e.to_string() }
-    };
     let path = dir.join("stats.json");
-    let mut w = create(&path)?;
-    serde_json::to_writer_pretty(&mut w, stats).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
-    std::io::Write::write_all(&mut w, b"\n").and_then(|()| std::io::Write::flush(&mut w)).map_err(io(&path))?;
-    Ok(())
+    write_atomic(&path, |w| {
+        serde_json::to_writer_pretty(&mut *w, stats)?;
+        std::io::Write::write_all(w, b"\n")
+    })
 }

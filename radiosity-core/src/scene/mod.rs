@@ -5,13 +5,15 @@ mod builder;
 mod cornell;
 mod error;
 pub mod generated;
+mod guard;
 pub mod mgf;
-mod obj;
+pub mod obj;
 pub mod shapes;
 
 pub use builder::SceneBuilder;
 pub use cornell::cornell_box;
 pub use error::SceneError;
+pub use guard::contain;
 
 use crate::geom::{Aabb, DVec3, Poly};
 use std::path::Path;

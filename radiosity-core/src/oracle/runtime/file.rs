@@ -180,13 +180,15 @@ pub fn parse_graph(text: &str, path: &Path) -> Result<Graph, GraphFileError> {
     }
 }
 
+/// A TOML error's message on one line (`toml` may give several lines, or none at the end of a file).
+fn toml_reason(e: &toml::de::Error) -> String {
+    let msg = e.message().trim();
+    if msg.is_empty() { "invalid TOML".to_owned() } else { msg.replace('\n', "; ") }
+}
+
 fn parse_file(text: &str, path: &Path, depth: usize) -> Result<Parsed, GraphFileError> {
     let file: FileGraph = toml::from_str(text).map_err(|e| GraphFileError {
-        errors: vec![Located {
-            path: path.to_owned(),
-            line: e.span().map(|s| line_of(text, s.start)),
-            message: e.message().trim().to_owned(),
-        }],
+        errors: vec![Located { path: path.to_owned(), line: e.span().map(|s| line_of(text, s.start)), message: toml_reason(&e) }],
     })?;
     let mut errors = Vec::new();
     let at = |span: std::ops::Range<usize>| line_of(text, span.start);

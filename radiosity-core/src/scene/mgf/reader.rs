@@ -177,11 +177,12 @@ impl Reader {
     fn run(&mut self, src: Rc<Source>, include_xf: Option<(XfSpec, usize)>) -> Result<(), SceneError> {
         let run = self.n_runs;
         self.n_runs += 1;
-        self.files.push(src.clone());
         let has_include_frame = include_xf.is_some();
         if let Some((spec, line)) = include_xf {
-            self.push_xf(spec, run, 0, true, line);
+            // Before the file is pushed: an error names the including file's `i` line.
+            self.push_xf(spec, run, 0, true, line)?;
         }
+        self.files.push(src.clone());
         let own_base = self.xf.len();
         let objects_base = self.objects.len();
         loop {
@@ -572,7 +573,7 @@ impl Reader {
     fn xf(&mut self, e: &Entity, run: usize, next: usize) -> Result<Option<usize>, SceneError> {
         if e.words.len() > 1 {
             let spec = XfSpec::parse(&e.words[1..]).map_err(|m| self.parse_err(e.line, m))?;
-            self.push_xf(spec, run, next, false, e.line);
+            self.push_xf(spec, run, next, false, e.line)?;
             return Ok(None);
         }
         match self.xf.last() {
@@ -587,7 +588,13 @@ impl Reader {
         Ok(None)
     }
 
-    fn push_xf(&mut self, spec: XfSpec, run: usize, resume: usize, include: bool, line: usize) {
+    fn push_xf(&mut self, spec: XfSpec, run: usize, resume: usize, include: bool, line: usize) -> Result<(), SceneError> {
+        let mut sizes = self.xf.iter().flat_map(|f| &f.spec.array_sizes).chain(&spec.array_sizes);
+        if sizes.try_fold(1usize, |acc, &n| acc.checked_mul(n)).is_none_or(|n| n > xform::MAX_INSTANCES) {
+            return Err(
+                self.parse_err(line, format!("array transform makes over {} instances (counting enclosing arrays)", xform::MAX_INSTANCES))
+            );
+        }
         let parent = self.xf.last().map_or(DAffine3::IDENTITY, |f| f.to_world);
         let idx = vec![0; spec.array_sizes.len()];
         let objects_base = (!idx.is_empty()).then_some(self.objects.len());
@@ -595,6 +602,7 @@ impl Reader {
         frame.update();
         self.xf.push(frame);
         self.push_instance_name();
+        Ok(())
     }
 
     /// Moves the innermost transform to its next array instance; false when it has none left.
@@ -638,7 +646,12 @@ impl Reader {
         let here = self.current_path();
         // Relative to the including file; `./` components dropped so that messages read cleanly.
         let path: PathBuf = here.parent().unwrap_or(Path::new("")).join(&**name).components().filter(|c| *c != Component::CurDir).collect();
-        let src = self.open(&path, None)?;
+        let line = e.line;
+        let src = self.open(&path, None).map_err(|err| match err {
+            // Named at the `i` line, with the reason, so the message says where the include is.
+            SceneError::Io { path, source } => self.parse_err(line, format!("cannot read included file `{}`: {source}", path.display())),
+            other => other,
+        })?;
         if let Some(pos) = self.files.iter().position(|f| f.key == src.key) {
             let chain: Vec<String> = self.files[pos..].iter().chain([&src]).map(|f| f.path.display().to_string()).collect();
             return Err(self.parse_err(e.line, format!("include cycle: {}", chain.join(" -> "))));

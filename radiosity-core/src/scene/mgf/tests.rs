@@ -104,8 +104,9 @@ fn missing_include_names_the_file() {
     let main = dir.join("main.mgf");
     std::fs::write(&main, "i nowhere/missing.mgf\n").unwrap();
     let err = load(&main).unwrap_err();
-    assert!(matches!(&err, SceneError::Io { path, .. } if path.ends_with("nowhere/missing.mgf")), "{err}");
-    assert!(err.to_string().contains("missing.mgf"), "{err}");
+    // Named at the `i` line of the including file (issue 17: errors name the file that was read).
+    assert!(matches!(&err, SceneError::Parse { path, line: 1, .. } if path == &main), "{err}");
+    assert!(err.to_string().contains("cannot read included file") && err.to_string().contains("nowhere/missing.mgf"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -257,4 +258,19 @@ fn spectra_and_temperatures() {
     let err = check_err(&format!("{basis}c s1\nrd .5\n"));
     assert!(matches!(&err, SceneError::Parse { line: 15, .. }), "{err}");
     assert!(err.to_string().contains("test.mgf:10"), "{err}");
+}
+
+/// Issue 17 (reader fuzz): `xf -a 4294967296` tried to build four billion instances and exhausted
+/// memory; arrays (with the enclosing ones) and `-i` repeats are capped.
+#[test]
+fn huge_arrays_are_errors_not_allocations() {
+    let text = format!("{SQUARE}m white =\n c\n rd .5\nxf -a 4294967296 -t 2 0 0\nf a b c d\nxf\n");
+    let e = check_err(&text).to_string();
+    assert_eq!(e, "test.mgf:12: array transform makes over 1000000 instances (counting enclosing arrays)");
+    let nested = format!("{SQUARE}m white =\n c\n rd .5\nxf -a 1000 -t 2 0 0\nxf -a 1001 -t 0 2 0\nf a b c d\nxf\nxf\n");
+    assert!(check_err(&nested).to_string().starts_with("test.mgf:13: array transform makes over"), "{}", check_err(&nested));
+    let repeat = format!("{SQUARE}m white =\n c\n rd .5\nxf -i 20000000 -t 2 0 0\nf a b c d\nxf\n");
+    assert_eq!(check_err(&repeat).to_string(), "test.mgf:12: transform repeat count `-i 20000000` is over 10000000");
+    // At the cap's scale but under it, arrays still work.
+    assert_eq!(check(&format!("{SQUARE}m white =\n c\n rd .5\nxf -a 3 -t 2 0 0\nxf -a 2 -t 0 2 0\nf a b c d\nxf\nxf\n")).polygons.len(), 6);
 }

@@ -8,6 +8,12 @@
 use super::lines::{parse_f64, parse_int};
 use glam::{DAffine3, DVec3};
 
+/// Most instances of an array, with the enclosing arrays' (`xf -a 4294967296` would otherwise
+/// exhaust memory: found by the reader fuzz, issue 17).
+pub(super) const MAX_INSTANCES: usize = 1_000_000;
+/// Most repeats of `-i` (each is a matrix product: ten million take a fraction of a second).
+const MAX_REPEATS: usize = 10_000_000;
+
 /// A parsed argument list; its matrix depends on the current array indices.
 #[derive(Clone, Debug)]
 pub(super) struct XfSpec {
@@ -76,6 +82,9 @@ impl XfSpec {
                     let n = count(i + 1, opt)?;
                     i += 1;
                     let n = usize::try_from(n).map_err(|_| format!("transform repeat count `-i {n}` is negative"))?;
+                    if n > MAX_REPEATS {
+                        return Err(format!("transform repeat count `-i {n}` is over {MAX_REPEATS}"));
+                    }
                     Op::Repeat(Count::Fixed(n))
                 }
                 "-a" => {
