@@ -1,5 +1,6 @@
 //! `radiosity solve`.
 
+use super::picture::PictureArgs;
 use super::progress::Reporter;
 use super::{SolveOptions, load_scene};
 use anyhow::Context;
@@ -63,6 +64,8 @@ pub struct SolveArgs {
     /// Plain scenes only: refused for instanced scenes and `--instances auto`.
     #[arg(long, value_name = "FILE.csv")]
     pub points: Option<PathBuf>,
+    #[command(flatten)]
+    pub picture: PictureArgs,
 }
 
 /// Most solves `--time-for` times.
@@ -100,6 +103,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         args.points.is_none() || !(instanced || args.instances == Instances::Auto),
         "--points applies to plain scenes, not to instanced ones (nor to --instances auto)"
     );
+    let (view, false_colour) = args.picture.settings(instanced || args.instances == Instances::Auto)?;
     if instanced {
         let path = args.scene.as_ref().expect("checked above");
         let scene = radiosity::instancing::load(path)?;
@@ -166,8 +170,12 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     stats.target_error = config.target_error;
-    let out_config =
-        OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
+    let out_config = OutputConfig {
+        image: !args.no_image,
+        render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() },
+        view,
+        false_colour,
+    };
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
     if let Some((points, results, seconds)) = &gathered {
         let path = args.out.join("points.csv");
@@ -186,12 +194,17 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     output::write_stats(&args.out, &stats)?;
     reporter.finish();
     if !args.quiet {
-        print_summary(&stats, &args.out);
+        let pictures = match (args.no_image, false_colour.is_some()) {
+            (true, _) => "",
+            (false, true) => "image.png,view.vf,falsecolor.png,",
+            (false, false) => "image.png,view.vf,",
+        };
+        print_summary(&stats, &args.out, pictures);
     }
     Ok(())
 }
 
-fn print_summary(s: &Stats, out: &std::path::Path) {
+fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
     if let Some(w) = s.warnings.summary() {
         eprintln!("warning: {w}");
     }
@@ -242,7 +255,7 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         println!("points: irradiance at {n} calculation points in {seconds:.3}s ({} rays)", s.point_rays.unwrap_or(0));
     }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
-    println!("wrote {}/{{image.png,solution.ply,patches.csv,stats.json{points}}}", out.display());
+    println!("wrote {}/{{{pictures}solution.ply,patches.csv,stats.json{points}}}", out.display());
 }
 
 /// An instanced scene (a `.toml` file, or a plain scene after `--instances auto`, whose `auto`

@@ -1,19 +1,26 @@
-//! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `solution.ply`, `patches.csv`,
+//! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `falsecolor.png`, `solution.ply`, `patches.csv`,
 //! `stats.json`, and `points.csv` with calculation points (names and columns are relied on by other
 //! tools: see DESIGN.md).
 
 mod csv;
+mod falsecolor;
 mod ply;
 mod points;
 mod render;
 mod smooth;
 mod stats;
+mod view;
 mod write;
 
 pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
 pub use ply::write_ply;
 pub use points::write_points_csv;
-pub use render::{RenderConfig, ToneMap, render, write_png};
+pub use falsecolor::{
+    ColourScale, FalseColourConfig, LEGEND_MIN_HEIGHT, LEGEND_WIDTH, PALETTE, Quantity, Scale, false_colour_image, format_label, nice_ceiling,
+    palette, write_false_colour,
+};
+pub use render::{Frame, OUTSIDE_PREFERENCE, RenderConfig, ToneMap, default_view, frame, mean_brightness, render, render_frame, write_png};
 pub use smooth::CornerValues;
 pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};
+pub use view::{Candidate, View, ViewError, ViewSpec, candidate_views, up_axis};
 pub use write::{OutputConfig, OutputError, write_solution, write_stats};

@@ -1,6 +1,9 @@
 //! Writes the four output files of a solve into a directory.
 
-use super::{CornerValues, RenderConfig, Stats, ToneMap, polygon_results, render, write_patches_csv, write_ply, write_png};
+use super::{
+    CornerValues, FalseColourConfig, RenderConfig, Stats, ToneMap, ViewSpec, frame, polygon_results, render_frame, write_false_colour,
+    write_patches_csv, write_ply, write_png,
+};
 use crate::pipeline::Solved;
 use crate::scene::Scene;
 use std::io::BufWriter;
@@ -23,11 +26,15 @@ pub struct OutputConfig {
     pub image: bool,
     /// Image settings.
     pub render: RenderConfig,
+    /// Radiance view options applied to the scene's camera or default view.
+    pub view: Option<ViewSpec>,
+    /// Write `falsecolor.png` beside `image.png` with these settings.
+    pub false_colour: Option<FalseColourConfig>,
 }
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        OutputConfig { image: true, render: RenderConfig::default() }
+        OutputConfig { image: true, render: RenderConfig::default(), view: None, false_colour: Some(FalseColourConfig::default()) }
     }
 }
 
@@ -35,7 +42,8 @@ fn create(path: &Path) -> Result<BufWriter<std::fs::File>, OutputError> {
     std::fs::File::create(path).map(BufWriter::new).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
 }
 
-/// Writes `patches.csv`, `solution.ply` and `image.png` (unless disabled) into `dir` (created if
+/// Writes `patches.csv`, `solution.ply`, `image.png` with its view `view.vf` (Radiance options that
+/// `--view` reads back) and `falsecolor.png` (unless disabled) into `dir` (created if
 /// needed); `stats.json` is written by [`write_stats`] once the output time is known.
 pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &OutputConfig) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|e| OutputError { path: dir.to_path_buf(), reason: e.to_string() })?;
@@ -57,9 +65,14 @@ pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &Outpu
 
     if config.image {
         let path = dir.join("image.png");
-        let rgb = render(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &config.render);
-        write_png(&path, &rgb, config.render.width, config.render.height)
-            .map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+        let frame = frame(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &config.render, config.view.as_ref());
+        let rgb = render_frame(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &frame, config.render.samples);
+        write_png(&path, &rgb, frame.width, frame.height).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+        let path = dir.join("view.vf");
+        std::fs::write(&path, format!("{}\n", frame.view)).map_err(io(&path))?;
+        if let Some(fc) = &config.false_colour {
+            write_false_colour(dir, scene, solved, &frame, config.render.samples, fc)?;
+        }
     }
 
     Ok(())
