@@ -51,7 +51,10 @@ fn every_scene_renders_well_above_black() {
         let fc = read_png(&out.join("falsecolor.png"));
         assert_eq!(fc.dimensions(), (SIZE + output::LEGEND_WIDTH, output::LEGEND_MIN_HEIGHT), "{}", scene.name);
         // The picture is at the top right of falsecolor.png; every pixel not black shows a surface.
-        let covered = (0..SIZE).flat_map(|y| (0..SIZE).map(move |x| (x, y))).filter(|&(x, y)| fc.get_pixel(output::LEGEND_WIDTH + x, y).0 != [0; 3]).count();
+        let covered = (0..SIZE)
+            .flat_map(|y| (0..SIZE).map(move |x| (x, y)))
+            .filter(|&(x, y)| fc.get_pixel(output::LEGEND_WIDTH + x, y).0 != [0; 3])
+            .count();
         let covered = covered as f64 / f64::from(SIZE * SIZE);
         report.push(format!("{}: mean {:.1}, false colour covers {:.0}%", scene.name, mean(&image), 100.0 * covered));
         assert!(mean(&image) > MIN_MEAN, "{}: image.png mean brightness {:.1} (all: {report:?})", scene.name, mean(&image));
@@ -72,7 +75,8 @@ fn view_options_frame_the_image() {
     // A view file as `rvu` saves it: 60° × 45°.
     let view = dir.path().join("stairs.vf");
     std::fs::write(&view, "rvu -vtv -vp 0.5 2 3 -vd 1 0 0 -vu 0 1 0 -vh 60 -vv 45 -vo 0 -va 0 -vs 0 -vl 0\n").expect("writes");
-    let o = radiosity(&["solve", "gen:stairs", "--eps", "0.5", "--size", "40", "-q", "-o", out_s, "--view", "-vh 60 -vv 45", "--scale", "log"]);
+    let o =
+        radiosity(&["solve", "gen:stairs", "--eps", "0.5", "--size", "40", "-q", "-o", out_s, "--view", "-vh 60 -vv 45", "--scale", "log"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // tan 30° / tan 22.5° = 1.394: 40 × 29.
     assert_eq!(read_png(&out.join("image.png")).dimensions(), (40, 29));
@@ -87,7 +91,19 @@ fn view_options_frame_the_image() {
     let again = dir.path().join("again");
     let saved_path = dir.path().join("saved.vf");
     std::fs::write(&saved_path, &saved).expect("writes");
-    let o = radiosity(&["solve", "gen:stairs", "--eps", "0.5", "--size", "24", "-q", "-o", again.to_str().expect("UTF-8"), "--view", saved_path.to_str().expect("UTF-8")]);
+    let o = radiosity(&[
+        "solve",
+        "gen:stairs",
+        "--eps",
+        "0.5",
+        "--size",
+        "24",
+        "-q",
+        "-o",
+        again.to_str().expect("UTF-8"),
+        "--view",
+        saved_path.to_str().expect("UTF-8"),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(read_png(&again.join("image.png")), image);
 }
@@ -104,7 +120,10 @@ fn malformed_views_are_one_line_errors() {
         ("-vp 1 2".to_owned(), "error: --view: view option -vp needs 3 numbers".to_owned()),
         ("-vd 0 0 0".to_owned(), "error: --view: view option -vd must not be the zero vector".to_owned()),
         ("-vh 0".to_owned(), "error: --view: view option -vh must be between 0 and 180 degrees (perspective), got 0".to_owned()),
-        (missing.display().to_string(), format!("error: {}: cannot read view file: No such file or directory (os error 2)", missing.display())),
+        (
+            missing.display().to_string(),
+            format!("error: {}: cannot read view file: No such file or directory (os error 2)", missing.display()),
+        ),
         (bad.display().to_string(), format!("error: {}:2: view type -vth is not supported (only -vtv, perspective)", bad.display())),
     ] {
         let o = radiosity(&["solve", "cornell", "--eps", "0.5", "--size", "8", "-q", "-o", out.to_str().expect("UTF-8"), "--view", &view]);

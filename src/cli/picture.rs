@@ -52,7 +52,10 @@ impl PictureArgs {
     /// The view spec and false-colour settings these options give, checked (`instanced`: the scene
     /// is solved as instances, which take no view and write no falsecolor.png).
     pub fn settings(&self, instanced: bool) -> anyhow::Result<(Option<ViewSpec>, Option<FalseColourConfig>)> {
-        anyhow::ensure!(self.view.is_none() || !instanced, "--view applies to plain scenes, not to instanced ones (nor to --instances auto)");
+        anyhow::ensure!(
+            self.view.is_none() || !instanced,
+            "--view applies to plain scenes, not to instanced ones (nor to --instances auto)"
+        );
         if let Some(max) = self.false_colour_max {
             anyhow::ensure!(max.is_finite() && max > 0.0, "--false-colour-max must be a positive number, got {max}");
         }

@@ -4,12 +4,12 @@
 
 use super::{CommonOptions, load_scene};
 use anyhow::Context;
+use plotters::prelude::*;
 use radiosity::geom::DVec3;
 use radiosity::output::polygon_results;
 use radiosity::pipeline::{self, Solved};
 use radiosity::refine::Oracle;
 use radiosity::scene::Scene;
-use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -181,8 +181,14 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
 }
 
 /// Colours of the plot's series, in order.
-const SERIES_COLOURS: [RGBColor; 6] =
-    [RGBColor(0x1f, 0x77, 0xb4), RGBColor(0xd6, 0x27, 0x28), RGBColor(0x2c, 0xa0, 0x2c), RGBColor(0x94, 0x67, 0xbd), RGBColor(0xff, 0x7f, 0x0e), RGBColor(0x8c, 0x56, 0x4b)];
+const SERIES_COLOURS: [RGBColor; 6] = [
+    RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0xff, 0x7f, 0x0e),
+    RGBColor(0x8c, 0x56, 0x4b),
+];
 /// Size of the plot, pixels.
 const PLOT_SIZE: (u32, u32) = (760, 460);
 /// Radius of the plot's marks, pixels.
@@ -209,9 +215,9 @@ fn draw_plot(
     let pos: Vec<&(String, f64, f64, f64)> = points.iter().filter(|p| usable(p.1) && usable(p.2)).collect();
     // Whole decades around every time, error and estimate.
     let decades = |values: &mut dyn Iterator<Item = f64>, empty: (f64, f64)| {
-        let (lo, hi) = values.filter(|&v| usable(v)).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v.log10().floor()), hi.max(v.log10().ceil()))
-        });
+        let (lo, hi) = values
+            .filter(|&v| usable(v))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v.log10().floor()), hi.max(v.log10().ceil())));
         let (lo, hi) = if lo.is_finite() { (lo, hi) } else { empty };
         (10f64.powf(lo), 10f64.powf(if hi > lo { hi } else { lo + 1.0 }))
     };
@@ -256,5 +262,30 @@ fn axis_label(v: f64) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_owned()
     } else {
         format!("{v:.0e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_plot_shows_each_series_error_and_estimate() {
+        let points: Vec<(String, f64, f64, f64)> = vec![
+            ("bf".into(), 0.1, 2.0, 3.0),
+            ("bf".into(), 0.5, 0.5, 0.8),
+            ("bf-dag".into(), 0.2, 1.5, f64::NAN),
+            ("bf-dag".into(), 0.0, 1.0, 1.0), // no time: left out
+        ];
+        let svg = svg_plot("a <scene>", &points).unwrap();
+        assert!(svg.starts_with("<svg"), "{svg}");
+        assert!(svg.contains("a &lt;scene&gt;: error against run time"), "the title, escaped");
+        for label in ["bf", "bf-dag", "run time (s, log)", "error, % of max (log); hollow: estimate"] {
+            assert!(svg.contains(&format!(">\n{label}\n<")) || svg.contains(&format!(">{label}<")), "{label}");
+        }
+        // Three filled marks (true errors) and two hollow ones (the finite estimates).
+        let circles: Vec<&str> = svg.lines().filter(|l| l.starts_with("<circle")).collect();
+        assert_eq!(circles.len(), 5, "{svg}");
+        assert_eq!(circles.iter().filter(|l| l.contains("fill=\"none\"")).count(), 2, "{svg}");
     }
 }

@@ -4,16 +4,16 @@
 //! `image.png`, with a legend on the left: a colour bar, its values and the unit.
 
 use super::render::{Frame, surface_hit, trace_pixels, write_png};
-use super::write::OutputError;
-use crate::pipeline::Solved;
-use std::path::{Path, PathBuf};
 use super::smooth::CornerValues;
+use super::write::OutputError;
 use crate::hierarchy::Hierarchy;
+use crate::pipeline::Solved;
 use crate::points::photopic;
 use crate::scene::Scene;
 use crate::solve::Solution;
 use crate::visibility::RayCaster;
 use font8x8::UnicodeFonts;
+use std::path::{Path, PathBuf};
 
 /// The colours of the scale, low to high, equally spaced (a spectrum from dark blue through cyan,
 /// green and yellow to dark red); values between two stops mix them linearly.
@@ -405,7 +405,11 @@ mod tests {
         assert_eq!(labels, ["0", "50", "100", "150", "200", "250"]);
         let log = ColourScale::new(Scale::Log, 250.0, 3.0);
         let labels: Vec<(String, String)> = log.labels().iter().map(|&(t, v)| (format!("{t:.3}"), format_label(v))).collect();
-        assert_eq!(labels, [("0.000", "0.25"), ("0.201", "1"), ("0.534", "10"), ("0.867", "100"), ("1.000", "250")].map(|(a, b)| (a.to_owned(), b.to_owned())));
+        assert_eq!(
+            labels,
+            [("0.000", "0.25"), ("0.201", "1"), ("0.534", "10"), ("0.867", "100"), ("1.000", "250")]
+                .map(|(a, b)| (a.to_owned(), b.to_owned()))
+        );
     }
 
     #[test]

@@ -13,12 +13,12 @@ mod view;
 mod write;
 
 pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
+pub use falsecolor::{
+    ColourScale, FalseColourConfig, LEGEND_MIN_HEIGHT, LEGEND_WIDTH, PALETTE, Quantity, Scale, false_colour_image, format_label,
+    nice_ceiling, palette, write_false_colour,
+};
 pub use ply::write_ply;
 pub use points::write_points_csv;
-pub use falsecolor::{
-    ColourScale, FalseColourConfig, LEGEND_MIN_HEIGHT, LEGEND_WIDTH, PALETTE, Quantity, Scale, false_colour_image, format_label, nice_ceiling,
-    palette, write_false_colour,
-};
 pub use render::{Frame, OUTSIDE_PREFERENCE, RenderConfig, ToneMap, default_view, frame, mean_brightness, render, render_frame, write_png};
 pub use smooth::CornerValues;
 pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};

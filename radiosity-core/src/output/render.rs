@@ -129,10 +129,12 @@ pub fn default_view(scene: &Scene, h: &Hierarchy, caster: &RayCaster, corners: &
             (mean_brightness(&rgb), c)
         })
         .collect();
-    let best = |outside: bool| scored.iter().filter(|(_, c)| c.outside || !outside).fold(None::<(f64, &Candidate)>, |b, &(s, c)| match b {
-        Some((bs, _)) if bs >= s => b,
-        _ => Some((s, c)),
-    });
+    let best = |outside: bool| {
+        scored.iter().filter(|(_, c)| c.outside || !outside).fold(None::<(f64, &Candidate)>, |b, &(s, c)| match b {
+            Some((bs, _)) if bs >= s => b,
+            _ => Some((s, c)),
+        })
+    };
     match (best(true), best(false)) {
         (Some((so, o)), Some((sa, _))) if so >= OUTSIDE_PREFERENCE * sa => o.view,
         (_, Some((_, a))) => a.view,

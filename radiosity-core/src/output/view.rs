@@ -224,7 +224,8 @@ impl ViewSpec {
             let mut numbers = |n: usize| -> Result<Vec<f64>, String> {
                 let mut out = Vec::with_capacity(n);
                 for _ in 0..n {
-                    let tok = tokens.next().ok_or_else(|| format!("view option {opt} needs {n} number{}", if n == 1 { "" } else { "s" }))?;
+                    let tok =
+                        tokens.next().ok_or_else(|| format!("view option {opt} needs {n} number{}", if n == 1 { "" } else { "s" }))?;
                     let x: f64 = tok.parse().map_err(|_| format!("view option {opt}: `{tok}` is not a number"))?;
                     if !x.is_finite() {
                         return Err(format!("view option {opt}: `{tok}` is not a finite number"));
@@ -361,7 +362,13 @@ pub fn candidate_views(bounds: &Aabb, up: DVec3, aspect: f64) -> Vec<Candidate> 
         (DVec3::Y, DVec3::Z)
     };
     let corners: Vec<DVec3> = (0..8)
-        .map(|k| c + DVec3::new(if k & 1 == 0 { -half.x } else { half.x }, if k & 2 == 0 { -half.y } else { half.y }, if k & 4 == 0 { -half.z } else { half.z }))
+        .map(|k| {
+            c + DVec3::new(
+                if k & 1 == 0 { -half.x } else { half.x },
+                if k & 2 == 0 { -half.y } else { half.y },
+                if k & 4 == 0 { -half.z } else { half.z },
+            )
+        })
         .collect();
     let mut out = Vec::with_capacity(8);
     let (elev, fov) = (OUTSIDE_ELEVATION_DEG.to_radians(), OUTSIDE_FOV_DEG.to_radians());
@@ -486,7 +493,8 @@ mod tests {
             let v = cand.view;
             let right = v.direction.cross(v.up);
             for k in 0..8 {
-                let p = DVec3::new(if k & 1 == 0 { 0.0 } else { 10.0 }, if k & 2 == 0 { 0.0 } else { 6.0 }, if k & 4 == 0 { 0.0 } else { 3.0 });
+                let p =
+                    DVec3::new(if k & 1 == 0 { 0.0 } else { 10.0 }, if k & 2 == 0 { 0.0 } else { 6.0 }, if k & 4 == 0 { 0.0 } else { 3.0 });
                 let o = p - v.position;
                 let z = o.dot(v.direction);
                 if cand.outside {
