@@ -39,7 +39,7 @@ fn mean(img: &image::RgbImage) -> f64 {
 #[test]
 fn every_scene_renders_well_above_black() {
     let dir = tempfile::tempdir().expect("a temporary folder");
-    let oracle = BfHand { params: BfParams { eps: EPS, ..BfParams::default() } };
+    let oracle = BfHand { params: BfParams { eps: EPS } };
     let mut report = Vec::new();
     for scene in scenes() {
         let solved = pipeline::run(&scene, &oracle, &Config { estimate_error: false, ..Config::default() }, &|_| {});

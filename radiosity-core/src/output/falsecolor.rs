@@ -48,6 +48,10 @@ pub const WATTS_PER_SQUARE_METRE: &str = "W/m²";
 const TEXT_COLOUR: [u8; 3] = [255, 255, 255];
 /// Side of a glyph of the legend's font, pixels.
 const GLYPH: u32 = 8;
+/// The glyph of `²` (rows top to bottom, bit 0 the leftmost pixel). font8x8 0.3.1 files three
+/// glyphs under U+00B2 (those of `²`, `³` and `´`) and its look-up finds the acute accent, so the
+/// legend's unit draws this one, font8x8's own `LATIN_LEGACY[18]`.
+const SUPERSCRIPT_TWO: [u8; 8] = [0x1C, 0x30, 0x18, 0x0C, 0x3C, 0x00, 0x00, 0x00];
 /// Margin around the legend's parts, pixels.
 const MARGIN: u32 = 6;
 /// Width of the legend's colour bar, pixels.
@@ -173,7 +177,7 @@ impl ColourScale {
                 for k in lo..=hi {
                     let v = 10f64.powi(k);
                     let t = self.position(v);
-                    if t >= LABEL_GAP && t <= 1.0 - LABEL_GAP {
+                    if (LABEL_GAP..=1.0 - LABEL_GAP).contains(&t) {
                         out.push((t, v));
                     }
                 }
@@ -334,7 +338,11 @@ impl Canvas {
     /// are drawn as `?`.
     fn text(&mut self, x: u32, y: u32, text: &str) {
         for (k, ch) in text.chars().enumerate() {
-            let glyph = font8x8::BASIC_FONTS.get(ch).or_else(|| font8x8::LATIN_FONTS.get(ch)).or_else(|| font8x8::BASIC_FONTS.get('?'));
+            let glyph = if ch == '²' {
+                Some(SUPERSCRIPT_TWO)
+            } else {
+                font8x8::BASIC_FONTS.get(ch).or_else(|| font8x8::LATIN_FONTS.get(ch)).or_else(|| font8x8::BASIC_FONTS.get('?'))
+            };
             let Some(glyph) = glyph else { continue };
             for (row, bits) in glyph.iter().enumerate() {
                 for col in 0..GLYPH {
@@ -436,5 +444,8 @@ mod tests {
             let lit = (0..8).flat_map(|y| (0..8).map(move |x| (x, y))).any(|(x, y)| c.rgb[3 * (y * 100 + 8 * k + x) as usize] == 255);
             assert!(lit, "glyph {k} drawn");
         }
+        // The fifth row of `²` is its foot, pixels 2 to 5 (the acute accent has none there).
+        let foot: Vec<bool> = (0..8).map(|x| c.rgb[3 * (4 * 100 + 24 + x) as usize] == 255).collect();
+        assert_eq!(foot, [false, false, true, true, true, true, false, false]);
     }
 }
