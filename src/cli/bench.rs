@@ -549,7 +549,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
         points.iter().filter(|p| p.1 > 0.0).map(|(r, worst, _, _)| (r.method.clone(), r.seconds, 100.0 * worst, 0.0)).collect();
     let svg_path = args.out.join("instancing_error_time.svg");
     let title = format!("tree age {} (reference: full at eps {})", args.age, args.eps);
-    radiosity::output::atomic::write_bytes(&svg_path, super::sweep::svg_plot(&title, &plotted))
+    radiosity::output::atomic::write_bytes(&svg_path, super::sweep::svg_plot(&title, &plotted)?)
         .with_context(|| format!("{}: cannot write", svg_path.display()))?;
 
     let (rf, ri, worst, mean, above) = (&points[0].0, &points[1].0, points[1].1, points[1].2, points[1].3);

@@ -143,7 +143,7 @@ fn write_files(out: &std::path::Path, rows: &[serde_json::Value]) -> anyhow::Res
         points.push(("RenderPark ward-room (worst class)".to_string(), time, err, 0.0));
     }
     let path = out.join("accuracy.svg");
-    radiosity::output::atomic::write_bytes(&path, super::sweep::svg_plot("Ward's room and the corner rooms", &points))
+    radiosity::output::atomic::write_bytes(&path, super::sweep::svg_plot("Ward's room and the corner rooms", &points)?)
         .with_context(|| format!("{}: cannot write", path.display()))?;
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! `radiosity solve`.
 
+use super::picture::PictureArgs;
 use super::progress::Reporter;
 use super::{SolveOptions, load_scene};
 use anyhow::Context;
@@ -85,6 +86,8 @@ pub struct SolveArgs {
     /// 0.2·5^log10(d), d the longer side).
     #[arg(long, value_name = "SPACING")]
     pub work_plane_spacing: Option<f64>,
+    #[command(flatten)]
+    pub picture: PictureArgs,
 }
 
 /// Values of `--up`.
@@ -141,6 +144,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         !has_grids || args.instances == Instances::None,
         "--grid and --work-plane apply to plain scenes, not to --instances auto"
     );
+    let (view, false_colour) = args.picture.settings(args.instances == Instances::Auto)?;
     // A scene file with luminaires, photometric units or grids is flattened and solved as a plain
     // scene.
     let mut lit_scene = None;
@@ -158,6 +162,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         } else {
             anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
             anyhow::ensure!(args.points.is_none(), "--points applies to plain scenes, not to instanced ones (nor to --instances auto)");
+            anyhow::ensure!(args.picture.view.is_none(), "--view applies to plain scenes, not to instanced ones (nor to --instances auto)");
             return solve_instanced(args, &scene, None);
         }
     }
@@ -248,8 +253,22 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     stats.target_error = config.target_error;
-    let out_config =
-        OutputConfig { image: !args.no_image, render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() } };
+    // Photometric scenes show lux (irradiance) or lm/m² (radiosity); the values are already in lm.
+    let false_colour = false_colour.map(|mut fc| {
+        if scene.units == radiosity::photometry::Units::Photometric {
+            fc.unit = match fc.quantity {
+                output::Quantity::Irradiance => "lx",
+                output::Quantity::Radiosity => "lm/m²",
+            };
+        }
+        fc
+    });
+    let out_config = OutputConfig {
+        image: !args.no_image,
+        render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() },
+        view,
+        false_colour,
+    };
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
     if let Some((points, results, seconds)) = &gathered {
         let path = args.out.join("points.csv");
@@ -270,12 +289,17 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     output::write_stats(&args.out, &stats)?;
     reporter.finish();
     if !args.quiet {
-        print_summary(&stats, &args.out);
+        let pictures = match (args.no_image, false_colour.is_some()) {
+            (true, _) => "",
+            (false, true) => "image.png,view.vf,falsecolor.png,",
+            (false, false) => "image.png,view.vf,",
+        };
+        print_summary(&stats, &args.out, pictures);
     }
     Ok(())
 }
 
-fn print_summary(s: &Stats, out: &std::path::Path) {
+fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
     if let Some(w) = s.warnings.summary() {
         eprintln!("warning: {w}");
     }
@@ -341,7 +365,7 @@ fn print_summary(s: &Stats, out: &std::path::Path) {
         grid_files.push_str(&format!(",grid_{name}.csv,grid_{name}.svg"));
     }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
-    println!("wrote {}/{{image.png,solution.ply,solution.glb,patches.csv,stats.json{points}{grid_files}}}", out.display());
+    println!("wrote {}/{{{pictures}solution.ply,solution.glb,patches.csv,stats.json{points}{grid_files}}}", out.display());
 }
 
 /// Writes `grid_<name>.csv` and `grid_<name>.svg` for each grid in the scene's `units` and returns

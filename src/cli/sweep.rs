@@ -1,9 +1,10 @@
 //! `radiosity sweep`: error against run time. Solves a scene with several oracles and thresholds,
 //! compares each solution with a reference (analytic where the scene has one, otherwise a converged
-//! solution computed once and cached), and writes `sweep.csv` and `sweep.svg`.
+//! solution computed once and cached), and writes `sweep.csv` and `sweep.svg` (drawn with plotters).
 
 use super::{CommonOptions, load_scene};
 use anyhow::Context;
+use plotters::prelude::*;
 use radiosity::geom::DVec3;
 use radiosity::output::polygon_results;
 use radiosity::pipeline::{self, Solved};
@@ -129,7 +130,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let csv_path = args.out.join("sweep.csv");
     radiosity::output::atomic::write_bytes(&csv_path, csv).with_context(|| format!("{}: cannot write", csv_path.display()))?;
     let svg_path = args.out.join("sweep.svg");
-    radiosity::output::atomic::write_bytes(&svg_path, svg_plot(&scene.name, &points))
+    radiosity::output::atomic::write_bytes(&svg_path, svg_plot(&scene.name, &points)?)
         .with_context(|| format!("{}: cannot write", svg_path.display()))?;
     println!("wrote {} and {}", csv_path.display(), svg_path.display());
     Ok(())
@@ -179,93 +180,112 @@ fn cached_reference(scene: &Scene, out: &Path, eps: f64, config: &pipeline::Conf
     Ok(results.iter().map(|r| r.b).collect())
 }
 
-/// A log–log plot of error (% of max) against run time, one series per oracle, with the estimates
-/// as hollow marks. Written by hand: a few dozen lines of SVG, no plotting dependency.
-/// Error against run time, log–log: `(series, time_s, error %, estimate %)` points (estimates as
-/// hollow circles where positive).
-pub fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> String {
-    let (w, h, m) = (760.0, 460.0, 60.0);
-    let pos: Vec<&(String, f64, f64, f64)> = points.iter().filter(|p| p.1 > 0.0 && p.2 > 0.0).collect();
-    let lx = |v: f64| v.log10();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    for p in &pos {
-        x0 = x0.min(lx(p.1).floor());
-        x1 = x1.max(lx(p.1).ceil());
-        for y in [p.2, p.3] {
-            if y > 0.0 && y.is_finite() {
-                y0 = y0.min(lx(y).floor());
-                y1 = y1.max(lx(y).ceil());
-            }
-        }
+/// Colours of the plot's series, in order.
+const SERIES_COLOURS: [RGBColor; 6] = [
+    RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0xff, 0x7f, 0x0e),
+    RGBColor(0x8c, 0x56, 0x4b),
+];
+/// Size of the plot, pixels.
+const PLOT_SIZE: (u32, u32) = (760, 460);
+/// Radius of the plot's marks, pixels.
+const MARK_RADIUS: i32 = 4;
+
+/// Error against run time, log–log, drawn with plotters' SVG backend: `(series, time_s, error %,
+/// estimate %)` points, one line of filled marks per series (the true error), with the estimates
+/// as hollow marks where positive.
+pub fn svg_plot(scene: &str, points: &[(String, f64, f64, f64)]) -> anyhow::Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, PLOT_SIZE).into_drawing_area();
+        draw_plot(&root, scene, points).map_err(|e| anyhow::anyhow!("drawing the plot of {scene}: {e}"))?;
     }
-    if !x0.is_finite() {
-        (x0, x1, y0, y1) = (-2.0, 1.0, -2.0, 2.0);
-    }
-    if x1 <= x0 {
-        x1 = x0 + 1.0;
-    }
-    if y1 <= y0 {
-        y1 = y0 + 1.0;
-    }
-    let sx = |v: f64| m + (lx(v) - x0) / (x1 - x0) * (w - 1.5 * m);
-    let sy = |v: f64| h - m - (lx(v) - y0) / (y1 - y0) * (h - 1.7 * m);
-    let mut s =
-        format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n");
-    let _ = writeln!(s, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
-    let _ = writeln!(s, "<text x=\"{}\" y=\"20\" text-anchor=\"middle\">{}: error against run time</text>", w / 2.0, xml(scene));
-    let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">run time (s, log)</text>", w / 2.0, h - 12.0);
-    let _ = writeln!(
-        s,
-        "<text x=\"14\" y=\"{}\" transform=\"rotate(-90 14 {})\" text-anchor=\"middle\">error, % of max (log); hollow: estimate</text>",
-        h / 2.0,
-        h / 2.0
-    );
-    for k in x0 as i32..=x1 as i32 {
-        let x = sx(10f64.powi(k));
-        let _ = writeln!(
-            s,
-            "<line x1=\"{x}\" y1=\"{}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{k}</text>",
-            m * 0.7,
-            h - m,
-            h - m + 16.0
-        );
-    }
-    for k in y0 as i32..=y1 as i32 {
-        let y = sy(10f64.powi(k));
-        let _ = writeln!(
-            s,
-            "<line x1=\"{m}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>",
-            w - m / 2.0,
-            m - 6.0,
-            y + 4.0
-        );
-    }
-    const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
+    Ok(svg)
+}
+
+fn draw_plot(
+    root: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    scene: &str,
+    points: &[(String, f64, f64, f64)],
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    let usable = |v: f64| v > 0.0 && v.is_finite();
+    let pos: Vec<&(String, f64, f64, f64)> = points.iter().filter(|p| usable(p.1) && usable(p.2)).collect();
+    // Whole decades around every time, error and estimate.
+    let decades = |values: &mut dyn Iterator<Item = f64>, empty: (f64, f64)| {
+        let (lo, hi) = values
+            .filter(|&v| usable(v))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v.log10().floor()), hi.max(v.log10().ceil())));
+        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { empty };
+        (10f64.powf(lo), 10f64.powf(if hi > lo { hi } else { lo + 1.0 }))
+    };
+    let (x0, x1) = decades(&mut pos.iter().map(|p| p.1), (-2.0, 1.0));
+    let (y0, y1) = decades(&mut pos.iter().flat_map(|p| [p.2, p.3]), (-2.0, 2.0));
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(format!("{scene}: error against run time"), ("sans-serif", 16))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("run time (s, log)")
+        .y_desc("error, % of max (log); hollow: estimate")
+        .x_label_formatter(&|v| axis_label(*v))
+        .y_label_formatter(&|v| axis_label(*v))
+        .light_line_style(RGBColor(0xee, 0xee, 0xee))
+        .draw()?;
     let mut names: Vec<&str> = pos.iter().map(|p| p.0.as_str()).collect();
     names.dedup();
     for (i, name) in names.iter().enumerate() {
-        let c = COLOURS[i % COLOURS.len()];
+        let colour = SERIES_COLOURS[i % SERIES_COLOURS.len()];
         let series: Vec<&&(String, f64, f64, f64)> = pos.iter().filter(|p| p.0 == *name).collect();
-        let path: Vec<String> = series.iter().map(|p| format!("{:.1},{:.1}", sx(p.1), sy(p.2))).collect();
-        let _ = writeln!(s, "<polyline points=\"{}\" fill=\"none\" stroke=\"{c}\"/>", path.join(" "));
-        for p in &series {
-            let _ = writeln!(s, "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{c}\"/>", sx(p.1), sy(p.2));
-            if p.3 > 0.0 && p.3.is_finite() {
-                let _ = writeln!(s, "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"none\" stroke=\"{c}\"/>", sx(p.1), sy(p.3));
-            }
-        }
-        let _ = writeln!(
-            s,
-            "<text x=\"{}\" y=\"{}\" fill=\"{c}\" text-anchor=\"end\">{}</text>",
-            w - m / 2.0 - 4.0,
-            h - m - 8.0 - 16.0 * (names.len() - 1 - i) as f64,
-            xml(name)
-        );
+        chart
+            .draw_series(LineSeries::new(series.iter().map(|p| (p.1, p.2)), colour))?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+        chart.draw_series(series.iter().map(|p| Circle::new((p.1, p.2), MARK_RADIUS, colour.filled())))?;
+        let estimates = series.iter().filter(|p| usable(p.3)).map(|p| Circle::new((p.1, p.3), MARK_RADIUS, colour.stroke_width(1)));
+        chart.draw_series(estimates)?;
     }
-    s.push_str("</svg>\n");
-    s
+    chart.configure_series_labels().position(SeriesLabelPosition::LowerRight).background_style(WHITE).border_style(BLACK).draw()?;
+    root.present()
 }
 
-fn xml(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+/// A tick label of a log axis: plain below 10⁴ and from 10⁻², else `1e-3`.
+fn axis_label(v: f64) -> String {
+    if (1e-2..1e4).contains(&v) {
+        let s = format!("{v:.2}");
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        format!("{v:.0e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_plot_shows_each_series_error_and_estimate() {
+        let points: Vec<(String, f64, f64, f64)> = vec![
+            ("bf".into(), 0.1, 2.0, 3.0),
+            ("bf".into(), 0.5, 0.5, 0.8),
+            ("bf-dag".into(), 0.2, 1.5, f64::NAN),
+            ("bf-dag".into(), 0.0, 1.0, 1.0), // no time: left out
+        ];
+        let svg = svg_plot("a <scene>", &points).unwrap();
+        assert!(svg.starts_with("<svg"), "{svg}");
+        assert!(svg.contains("a &lt;scene&gt;: error against run time"), "the title, escaped");
+        for label in ["bf", "bf-dag", "run time (s, log)", "error, % of max (log); hollow: estimate"] {
+            assert!(svg.contains(&format!(">\n{label}\n<")) || svg.contains(&format!(">{label}<")), "{label}");
+        }
+        // Three filled marks (true errors) and two hollow ones (the finite estimates).
+        let circles: Vec<&str> = svg.lines().filter(|l| l.starts_with("<circle")).collect();
+        assert_eq!(circles.len(), 5, "{svg}");
+        assert_eq!(circles.iter().filter(|l| l.contains("fill=\"none\"")).count(), 2, "{svg}");
+    }
 }

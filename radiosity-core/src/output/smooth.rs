@@ -18,15 +18,22 @@ pub struct CornerValues {
 }
 
 impl CornerValues {
-    /// Computes corner values for every leaf of `h`.
+    /// Computes corner radiosity for every leaf of `h`.
     #[must_use]
     pub fn new(h: &Hierarchy, solution: &Solution) -> CornerValues {
+        CornerValues::from_values(h, &solution.radiosity)
+    }
+
+    /// Computes corner values for every leaf of `h` from per-element `values` (radiosity,
+    /// irradiance, ...), smoothed as the radiosity is.
+    #[must_use]
+    pub fn from_values(h: &Hierarchy, values: &[[f64; 3]]) -> CornerValues {
         let leaves: Vec<ElementId> = h.leaves().filter(|&e| !h.get(e).is_cluster()).collect();
         let mut slot = vec![NONE; h.len()];
         for (i, &e) in leaves.iter().enumerate() {
             slot[e as usize] = i as u32;
         }
-        let values = leaves.par_iter().map(|&e| corner_values(h, solution, e)).collect();
+        let values = leaves.par_iter().map(|&e| corner_values(h, values, e)).collect();
         CornerValues { slot, values }
     }
 
@@ -50,20 +57,20 @@ impl CornerValues {
     }
 }
 
-fn corner_values(h: &Hierarchy, solution: &Solution, leaf: ElementId) -> [[f64; 3]; 4] {
+fn corner_values(h: &Hierarchy, values: &[[f64; 3]], leaf: ElementId) -> [[f64; 3]; 4] {
     let e = h.get(leaf);
     let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return [[0.0; 3]; 4] };
     let root = h.get(polygon).poly().copied().expect("polygon roots are surfaces");
     let mut out = [[0.0; 3]; 4];
     for (k, &v) in poly.vertices().iter().enumerate() {
         let (s, t) = root.param_of_point(v);
-        out[k] = around(h, solution, &root, polygon, s, t);
+        out[k] = around(h, values, &root, polygon, s, t);
     }
     out
 }
 
-/// Mean radiosity of the distinct leaves touching parameter point `(s, t)` of polygon `polygon`.
-fn around(h: &Hierarchy, solution: &Solution, root: &Poly, polygon: u32, s: f64, t: f64) -> [f64; 3] {
+/// Mean value of the distinct leaves touching parameter point `(s, t)` of polygon `polygon`.
+fn around(h: &Hierarchy, values: &[[f64; 3]], root: &Poly, polygon: u32, s: f64, t: f64) -> [f64; 3] {
     let mut seen: [ElementId; 8] = [NONE; 8];
     let mut n = 0;
     let mut acc = [0.0; 3];
@@ -82,14 +89,14 @@ fn around(h: &Hierarchy, solution: &Solution, root: &Poly, polygon: u32, s: f64,
         }
         seen[n] = leaf;
         n += 1;
-        let b = solution.radiosity[leaf as usize];
+        let b = values[leaf as usize];
         for c in 0..3 {
             acc[c] += b[c];
         }
     }
     if n == 0 {
         let (leaf, _, _) = h.locate(polygon, s.clamp(0.0, 1.0), t.clamp(0.0, 1.0));
-        return solution.radiosity[leaf as usize];
+        return values[leaf as usize];
     }
     acc.map(|v| v / n as f64)
 }

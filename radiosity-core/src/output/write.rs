@@ -1,9 +1,13 @@
 //! Writes the output files of a solve into a directory, each atomically ([`super::atomic`]).
 
 use super::atomic::AtomicFile;
-use super::{CornerValues, RenderConfig, Stats, ToneMap, polygon_results, render, write_glb, write_patches_csv, write_ply, write_png};
+use super::{
+    CornerValues, FalseColourConfig, RenderConfig, Stats, ToneMap, ViewSpec, frame, polygon_results, render_frame, write_false_colour,
+    write_glb, write_patches_csv, write_ply, write_png,
+};
 use crate::pipeline::Solved;
 use crate::scene::Scene;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A file that could not be written.
@@ -23,11 +27,15 @@ pub struct OutputConfig {
     pub image: bool,
     /// Image settings.
     pub render: RenderConfig,
+    /// Radiance view options applied to the scene's camera or default view.
+    pub view: Option<ViewSpec>,
+    /// Write `falsecolor.png` beside `image.png` with these settings.
+    pub false_colour: Option<FalseColourConfig>,
 }
 
 impl Default for OutputConfig {
     fn default() -> Self {
-        OutputConfig { image: true, render: RenderConfig::default() }
+        OutputConfig { image: true, render: RenderConfig::default(), view: None, false_colour: Some(FalseColourConfig::default()) }
     }
 }
 
@@ -36,7 +44,8 @@ fn write_atomic(path: &Path, write: impl FnOnce(&mut AtomicFile) -> std::io::Res
     super::atomic::write_file(path, write).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
 }
 
-/// Writes `patches.csv`, `solution.ply`, `solution.glb` and `image.png` (unless disabled) into `dir` (created if
+/// Writes `patches.csv`, `solution.ply`, `solution.glb`, `image.png` with its view `view.vf`
+/// (Radiance options that `--view` reads back) and `falsecolor.png` (unless disabled) into `dir` (created if
 /// needed); `stats.json` is written by [`write_stats`] once the output time is known.
 pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &OutputConfig) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|e| OutputError { path: dir.to_path_buf(), reason: e.to_string() })?;
@@ -54,9 +63,14 @@ pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &Outpu
 
     if config.image {
         let path = dir.join("image.png");
-        let rgb = render(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &config.render);
-        write_png(&path, &rgb, config.render.width, config.render.height)
-            .map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+        let frame = frame(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &config.render, config.view.as_ref());
+        let rgb = render_frame(scene, &solved.hierarchy, &solved.caster, &corners, &tone, &frame, config.render.samples);
+        write_png(&path, &rgb, frame.width, frame.height).map_err(|e| OutputError { path: path.clone(), reason: e.to_string() })?;
+        let path = dir.join("view.vf");
+        write_atomic(&path, |w| writeln!(w, "{}", frame.view))?;
+        if let Some(fc) = &config.false_colour {
+            write_false_colour(dir, scene, solved, &frame, config.render.samples, fc)?;
+        }
     }
 
     Ok(())

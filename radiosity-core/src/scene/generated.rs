@@ -253,6 +253,24 @@ pub fn rotated_occluders() -> Scene {
     g.finish(look_at(DVec3::new(7.5, 3.5, 5.8), DVec3::new(3.5, 0.8, 2.5)))
 }
 
+/// Names of the scenes built by code rather than loaded (`radiosity solve NAME`): the embedded
+/// Cornell box and the generated scenes of this module ([`by_name`] builds them).
+pub const NAMES: &[&str] = &["cornell", "gen:duplex", "gen:sj-geometry", "gen:sj-shadow", "gen:stairs", "gen:rotated"];
+
+/// The scene of a name in [`NAMES`]; `None` for any other name.
+#[must_use]
+pub fn by_name(name: &str) -> Option<Scene> {
+    Some(match name {
+        "cornell" => super::cornell_box(),
+        "gen:duplex" => duplex(),
+        "gen:sj-geometry" => smits_jensen_geometry(),
+        "gen:sj-shadow" => smits_jensen_shadow(),
+        "gen:stairs" => stairs_with_beam(),
+        "gen:rotated" => rotated_occluders(),
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -266,5 +284,9 @@ mod tests {
             assert!(scene.camera.is_some());
             assert!(scene.polygons.len() > 20, "{}: {} polygons", scene.name, scene.polygons.len());
         }
+        for name in NAMES {
+            assert!(by_name(name).is_some(), "{name} builds");
+        }
+        assert!(by_name("gen:nothing").is_none());
     }
 }

@@ -215,6 +215,21 @@ impl RayCaster {
         }
     }
 
+    /// [`RayCaster::closest_hit`] among the input polygons that `accept` takes: the others let the
+    /// ray through (the renderer sees through the backs of one-sided surfaces this way).
+    #[must_use]
+    pub fn closest_hit_where(&self, origin: DVec3, dir: DVec3, accept: impl Fn(u32) -> bool) -> Option<(f64, u32)> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let ray = Ray::new(self.to_local(origin), ray_direction(dir), 0.0, f32::INFINITY);
+        let mut hit = obvhs::ray::RayHit::none();
+        let found = self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
+            if accept(self.tri_polygon[id]) { self.triangles[id].intersect(ray) } else { f32::INFINITY }
+        });
+        found.then(|| (hit.t as f64 / self.frame.inv_scale, self.tri_polygon[hit.primitive_id as usize]))
+    }
+
     /// True when the ray from `origin` along `dir` (scene coordinates) meets no triangle: an
     /// occlusion query, cheaper than [`RayCaster::closest_hit`]. Direction components that are
     /// exactly zero are nudged (see `ray_direction`).
