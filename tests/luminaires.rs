@@ -241,3 +241,90 @@ fn room_lit_by_a_luminaire_matches_the_dense_reference() {
         assert!(estimate >= worst, "estimate {estimate} below the true error {worst}");
     }
 }
+
+fn shipped(name: &str) -> Arc<Photometry> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("radiosity-core/data/luminaires").join(name);
+    Arc::new(radiosity::photometry::read(&path).unwrap())
+}
+
+/// CIE 171 5.2 and 5.4 from the shipped IES files (`radiosity-core/data/luminaires/`): the
+/// Lambertian source's ten points within 1e-3 of `I0 h²/d⁴`, the isotropic source's flux received
+/// by a closed black room within 0.5% of its 10,000 lm.
+#[test]
+fn cie171_cases_from_the_shipped_ies_files() {
+    let lambert = shipped("lambert_1000cd.ies");
+    let mut b = SceneBuilder::new(Path::new("plane"), "plane");
+    let m = b.material(Material::diffuse("black", [0.0; 3])).unwrap();
+    let g = b.group("plane");
+    b.face(&[DVec3::new(-2.0, -2.0, 0.0), DVec3::new(2.0, -2.0, 0.0), DVec3::new(2.0, 2.0, 0.0), DVec3::new(-2.0, 2.0, 0.0)], m, g, 0)
+        .unwrap();
+    let scene = with_luminaires(b.finish(), vec![down("lambert", lambert, DVec3::new(0.0, 0.0, 3.0))]);
+    let solved = solve(&scene);
+    let offsets = [(0.0, 0.0), (0.5, 0.0), (1.0, 0.0), (1.5, 0.0), (0.5, 0.5), (1.0, 0.5), (1.5, 0.5), (1.0, 1.0), (1.5, 1.0), (1.5, 1.5)];
+    let points: Vec<CalcPoint> =
+        offsets.iter().map(|&(x, y)| CalcPoint { name: String::new(), position: DVec3::new(x, y, 0.0), normal: DVec3::Z }).collect();
+    for ((x, y), r) in offsets.iter().zip(radiosity::points::gather(&solved, &points, &PointsConfig::default())) {
+        let d2 = x * x + y * y + 9.0;
+        let exact = 1000.0 * 9.0 / (d2 * d2);
+        assert!((r.photopic() / exact - 1.0).abs() <= 1e-3, "({x}, {y}): {} lx against {exact}", r.photopic());
+    }
+    let iso = down("iso", shipped("isotropic_10000lm.ies"), DVec3::new(1.0, 3.0, 2.0));
+    assert!((iso.flux() / 10_000.0 - 1.0).abs() <= 1e-3, "file flux {}", iso.flux());
+    let scene = with_luminaires(room(DVec3::ZERO, DVec3::new(4.0, 4.0, 3.0), 0.0, &[]), vec![iso]);
+    let solved = solve(&scene);
+    let ratio = luminaire::flux_received(&solved.hierarchy) / 10_000.0;
+    assert!((ratio - 1.0).abs() <= FLUX_TOL, "received / emitted {ratio}");
+}
+
+/// The README's lighting example end to end: `radiosity solve examples/lighting/office.toml` writes
+/// lux on the work plane with the EN 12464-1 figures, in photometric units, with the luminaires'
+/// flux all absorbed (a closed room) and the figures in stats.json those of grid_work.csv.
+#[test]
+fn office_example_end_to_end() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = tempfile::tempdir().unwrap();
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .current_dir(root)
+        .args(["solve", "examples/lighting/office.toml", "--quiet", "--size", "64", "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.path().join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["units"], "photometric");
+    assert_eq!(stats["luminaires"].as_array().unwrap().len(), 2);
+    let balance = stats["power_balance"].as_f64().unwrap();
+    assert!((balance - 1.0).abs() <= FLUX_TOL, "balance {balance}");
+    let emitted = stats["power_emitted"].as_f64().unwrap();
+    let declared: f64 = stats["luminaires"].as_array().unwrap().iter().map(|l| l["declared_lm"].as_f64().unwrap()).sum();
+    assert!((emitted / declared - 1.0).abs() <= FLUX_TOL, "emitted {emitted} lm, the files declare {declared}");
+    let csv = std::fs::read_to_string(out.path().join("grid_work.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "e_lx").expect("e_lx column");
+    let values: Vec<f64> = lines.map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect();
+    assert_eq!(values.len(), 20 * 12);
+    let avg = values.iter().sum::<f64>() / values.len() as f64;
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let work = &stats["grids"]["work"];
+    assert!((work["e_avg"].as_f64().unwrap() / avg - 1.0).abs() < 1e-12);
+    assert!((work["u0"].as_f64().unwrap() - min / avg).abs() < 1e-12);
+    // Every point gets at least the luminaires' direct light (nothing stands between them and the
+    // work plane: the desk is below it), and the interreflections add a fraction of it.
+    let (_, lighting) = radiosity::instancing::load_with_lighting(&root.join("examples/lighting/office.toml")).unwrap();
+    let mut indirect_share = Vec::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<f64> = line.split(',').skip(1).take(6).map(|v| v.parse().unwrap()).collect();
+        let (x, n) = (DVec3::new(f[0], f[1], f[2]), DVec3::new(f[3], f[4], f[5]));
+        let direct: f64 = lighting.luminaires.iter().map(|l| l.illuminance_unoccluded(x, n)).sum();
+        let e: f64 = line.split(',').nth(col).unwrap().parse().unwrap();
+        assert!(e >= direct, "at {x}: {e} lx below the direct {direct} lx");
+        indirect_share.push((e - direct) / e);
+    }
+    let share = indirect_share.iter().sum::<f64>() / indirect_share.len() as f64;
+    assert!((0.05..0.5).contains(&share), "interreflections {share} of the work plane's light");
+    assert!(min > 0.0);
+    for f in ["image.png", "falsecolor.png", "solution.glb", "grid_work.svg", "patches.csv"] {
+        assert!(out.path().join(f).exists(), "{f} written");
+    }
+}

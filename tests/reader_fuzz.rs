@@ -32,6 +32,35 @@ const SLOW_INPUT: Duration = Duration::from_secs(2);
 
 const CORNELL_OBJ: &str = include_str!("../radiosity-core/data/cornell_box_measured.obj");
 const CORNELL_MTL: &str = include_str!("../radiosity-core/data/cornell_box_measured.mtl");
+const IES_DOWNLIGHT: &str = include_str!("../radiosity-core/data/luminaires/downlight_asymmetric.ies");
+const IES_LINEAR: &str = include_str!("../radiosity-core/data/luminaires/linear_example.ies");
+const LDT_DOWNLIGHT: &str = include_str!("../radiosity-core/data/luminaires/downlight_asymmetric.ldt");
+
+/// A lighting scene file: units, a luminaire (one of the shipped files) and a grid.
+const LIT_TOML: &str = r#"# fuzz seed: lighting
+units = "photometric"
+[[material]]
+name = "grey"
+reflectance = 0.5
+[[box]]
+min = [0, 0, 0]
+max = [4, 4, 3]
+material = "grey"
+inward = true
+[[luminaire]]
+ies = "downlight_asymmetric.ies"
+position = [2.0, 2.0, 2.9]
+aim = [0.0, 0.0, -1.0]
+rotate = 15.0
+multiplier = 1.5
+[[grid]]
+name = "work"
+origin = [0.5, 0.5, 0.8]
+u = [3.0, 0.0, 0.0]
+v = [0.0, 3.0, 0.0]
+spacing = 0.25
+normal = [0.0, 0.0, 1.0]
+"#;
 
 const MGF_ROOM: &str = "# fuzz seed: a room with a lamp, colours and transforms
 c red =
@@ -227,6 +256,8 @@ fn targets() -> Vec<Target> {
     ];
     const TOML_KEYS: &[&str] =
         &["[[material]]", "[[prototype]]", "[[instance]]", "[[node]]", "name =", "of =", "obj =", "uses =", "start ="];
+    const LIT_KEYS: &[&str] = &["units =", "[[luminaire]]", "[[grid]]", "ies =", "ldt =", "aim =", "spacing =", "normal =", "u ="];
+    const IES_KEYS: &[&str] = &["TILT=NONE", "TILT=INCLUDE", "TILT=lamp.tlt", "IESNA:LM-63-2002", "IESNA:LM-63-1995", "[TEST]", "0", "-1"];
     const CSV_KEYS: &[&str] = &["name,x,y,z,nx,ny,nz", "x,y,z,nx,ny,nz", "\"", ",", "#"];
     vec![
         Target::new("obj", "scene.obj", &[CORNELL_OBJ], OBJ_KEYS, |text, path| {
@@ -242,6 +273,16 @@ fn targets() -> Vec<Target> {
         }),
         Target::new("instanced", "scene.toml", &[INSTANCED], TOML_KEYS, |text, path| {
             instancing::parse(text, path, Path::new("no-such-dir")).map(drop).map_err(|e| e.to_string())
+        }),
+        Target::new("lighting", "room.toml", &[LIT_TOML], LIT_KEYS, |text, path| {
+            let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("radiosity-core/data/luminaires");
+            instancing::parse_with_lighting(text, path, &dir).map(drop).map_err(|e| e.to_string())
+        }),
+        Target::new("ies", "lamp.ies", &[IES_DOWNLIGHT, IES_LINEAR], IES_KEYS, |text, path| {
+            radiosity::photometry::parse_ies(text, &path.display().to_string()).map(drop).map_err(|e| e.to_string())
+        }),
+        Target::new("ldt", "lamp.ldt", &[LDT_DOWNLIGHT], &["0", "1", "2", "3", "4", "-1"], |text, path| {
+            radiosity::photometry::parse_ldt(text, &path.display().to_string()).map(drop).map_err(|e| e.to_string())
         }),
         Target::new("graph", "graph.toml", &[GRAPH], TOML_KEYS, |text, path| parse_graph(text, path).map(drop).map_err(|e| e.to_string())),
         Target::new("points", "points.csv", &[POINTS_HEADER, POINTS_PLAIN], CSV_KEYS, |text, path| {

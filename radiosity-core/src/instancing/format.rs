@@ -323,7 +323,10 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
             return Err(InstancingError::at(path, line, "luminaires need `units = \"photometric\"` (their intensities are in cd)"));
         }
         let photometry = crate::photometry::read(&dir.join(file)).map_err(|e| InstancingError::at(path, line, e.to_string()))?;
-        let name = ls.name.clone().unwrap_or_else(|| file.clone());
+        let name = ls
+            .name
+            .clone()
+            .unwrap_or_else(|| Path::new(file).file_name().map_or_else(|| file.clone(), |n| n.to_string_lossy().into_owned()));
         let lum = crate::luminaire::Luminaire::new(
             &name,
             std::sync::Arc::new(photometry),
