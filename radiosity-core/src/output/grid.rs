@@ -1,7 +1,6 @@
 //! `grid_<name>.csv` and `grid_<name>.svg` (with `radiosity solve --grid` or `--work-plane`): each
 //! grid's points with their irradiance, and an isolux plot of them.
 
-use super::csv_field;
 use crate::photometry::Units;
 use crate::points::PointIrradiance;
 use crate::points::grid::{Grid, GridSummary, photopic_column, photopic_unit};
@@ -21,29 +20,10 @@ const PLOT_HEIGHT_RANGE: (f64, f64) = (240.0, 900.0);
 /// contouring's closure along the border, not a contour: they are left out.
 const HULL_TOL_CELLS: f64 = 1e-9;
 
-/// Writes `grid_<name>.csv`: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,<photopic>`, one row per point in
-/// the grid's order, the photopic column named by [`photopic_column`] (`e_lx` or `h_photopic`).
+/// Writes `grid_<name>.csv`: the grid's points in its order, in the columns of `points.csv`
+/// ([`super::write_points_csv_in`]: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units`).
 pub fn write_grid_csv(w: &mut impl Write, grid: &Grid, results: &[PointIrradiance], units: Units) -> std::io::Result<()> {
-    writeln!(w, "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,{}", photopic_column(units))?;
-    for (p, r) in grid.points.iter().zip(results) {
-        let (x, n) = (p.position, p.normal);
-        writeln!(
-            w,
-            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e}",
-            csv_field(&p.name),
-            x.x,
-            x.y,
-            x.z,
-            n.x,
-            n.y,
-            n.z,
-            r.h[0],
-            r.h[1],
-            r.h[2],
-            r.photopic()
-        )?;
-    }
-    Ok(())
+    super::write_points_csv_in(w, &grid.points, results, units)
 }
 
 /// Contour levels for values between `min` and `max`: the multiples of a 1-2-2.5-5 step strictly
