@@ -147,5 +147,5 @@ fn cornell_glb_matches_the_ply() {
     let mut names: Vec<String> =
         std::fs::read_dir(dir.path()).expect("dir").map(|e| e.expect("entry").file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names, ["patches.csv", "solution.glb", "solution.ply"]);
+    assert_eq!(names, ["groups.csv", "patches.csv", "solution.glb", "solution.ply"]);
 }

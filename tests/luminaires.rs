@@ -324,7 +324,21 @@ fn office_example_end_to_end() {
     let share = indirect_share.iter().sum::<f64>() / indirect_share.len() as f64;
     assert!((0.05..0.5).contains(&share), "interreflections {share} of the work plane's light");
     assert!(min > 0.0);
-    for f in ["image.png", "falsecolor.png", "solution.glb", "grid_work.svg", "patches.csv"] {
+    // Absorbed power: patches.csv's per polygon, groups.csv's per group, and stats.json's total
+    // are one sum, equal to the luminaires' flux in this closed room.
+    let column_sums = |file: &str, name: &str| -> f64 {
+        let text = std::fs::read_to_string(out.path().join(file)).unwrap();
+        let mut lines = text.lines();
+        let k = lines.next().unwrap().split(',').position(|h| h == name).unwrap_or_else(|| panic!("{file}: no {name}"));
+        lines.map(|l| l.split(',').nth(k).unwrap().parse::<f64>().unwrap()).sum()
+    };
+    let absorbed = stats["power_absorbed"].as_f64().unwrap();
+    for file in ["patches.csv", "groups.csv"] {
+        let sum = column_sums(file, "absorbed_g");
+        assert!((sum / absorbed - 1.0).abs() < 1e-9, "{file}: absorbed {sum} against stats.json's {absorbed}");
+    }
+    assert!((absorbed / declared - 1.0).abs() <= FLUX_TOL, "absorbed {absorbed} lm of {declared}");
+    for f in ["image.png", "falsecolor.png", "solution.glb", "grid_work.svg", "patches.csv", "groups.csv"] {
         assert!(out.path().join(f).exists(), "{f} written");
     }
 }

@@ -365,7 +365,7 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
         grid_files.push_str(&format!(",grid_{name}.csv,grid_{name}.svg"));
     }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
-    println!("wrote {}/{{{pictures}solution.ply,solution.glb,patches.csv,stats.json{points}{grid_files}}}", out.display());
+    println!("wrote {}/{{{pictures}solution.ply,solution.glb,patches.csv,groups.csv,stats.json{points}{grid_files}}}", out.display());
 }
 
 /// Writes `grid_<name>.csv` and `grid_<name>.svg` for each grid in the scene's `units` and returns

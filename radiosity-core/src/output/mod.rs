@@ -1,5 +1,5 @@
 //! Step 5, `output`: the files `radiosity solve` writes — `image.png`, `falsecolor.png`,
-//! `solution.ply`, `solution.glb`, `patches.csv`, `stats.json`, `points.csv` with calculation points,
+//! `solution.ply`, `solution.glb`, `patches.csv`, `groups.csv`, `stats.json`, `points.csv` with calculation points,
 //! and `grid_<name>.csv` / `.svg` with grids (names and columns are relied on by other
 //! tools: see DESIGN.md).
 
@@ -16,7 +16,7 @@ mod stats;
 mod view;
 mod write;
 
-pub use csv::{PolygonResult, csv_field, polygon_results, write_patches_csv};
+pub use csv::{PolygonResult, csv_field, polygon_results, write_groups_csv, write_patches_csv};
 pub use falsecolor::{
     BACKGROUND, ColourScale, DEFAULT_LOG_DECADES, DEFAULT_MAX_AREA_SHARE, FalseColourConfig, LEGEND_MIN_HEIGHT, LEGEND_WIDTH, LINEAR_STEPS,
     PALETTE, Quantity, Scale, WATTS_PER_SQUARE_METRE, default_max, false_colour_image, format_label, nice_ceiling, palette,

@@ -44,7 +44,7 @@ fn write_atomic(path: &Path, write: impl FnOnce(&mut AtomicFile) -> std::io::Res
     super::atomic::write_file(path, write).map_err(|e| OutputError { path: path.to_path_buf(), reason: e.to_string() })
 }
 
-/// Writes `patches.csv`, `solution.ply`, `solution.glb`, `image.png` with its view `view.vf`
+/// Writes `patches.csv`, `groups.csv`, `solution.ply`, `solution.glb`, `image.png` with its view `view.vf`
 /// (Radiance options that `--view` reads back) and `falsecolor.png` (unless disabled) into `dir` (created if
 /// needed); `stats.json` is written by [`write_stats`] once the output time is known.
 pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &OutputConfig) -> Result<(), OutputError> {
@@ -52,6 +52,8 @@ pub fn write_solution(dir: &Path, scene: &Scene, solved: &Solved, config: &Outpu
     let results = polygon_results(&solved.hierarchy, &solved.solution);
     let path = dir.join("patches.csv");
     write_atomic(&path, |w| write_patches_csv(w, scene, &results))?;
+    let path = dir.join("groups.csv");
+    write_atomic(&path, |w| super::write_groups_csv(w, scene, &results))?;
 
     let per_polygon: Vec<[f64; 3]> = results.iter().map(|r| r.b).collect();
     let tone = ToneMap::from_scene(scene, &per_polygon);
