@@ -139,35 +139,22 @@ pub const MAX_SHADOW_DEPTH: u16 = 6;
 /// Shadow rays start this far (relative to the scene's diagonal) off the receiver, along its normal.
 pub const SHADOW_ORIGIN_OFFSET_REL: f64 = 1e-5;
 
-/// The quadrature points and weights (summing to 1) of a surface element: the 9-point rule on
-/// quads (weighted by the bilinear map's Jacobian), the 6-point rule on triangles.
-fn element_rule(poly: &crate::geom::Poly) -> Vec<(DVec3, f64)> {
+/// The quadrature rule of a surface element: 9 points on quads, 6 on triangles.
+fn element_rule(poly: &crate::geom::Poly) -> &'static quadrature::Rule {
     match poly.kind {
-        PolyKind::Quad => {
-            let rule = &quadrature::QUAD_9;
-            let mut pts: Vec<(DVec3, f64)> = rule
-                .points
-                .iter()
-                .zip(rule.weights)
-                .map(|(&(u, v), &w)| {
-                    let du = (1.0 - v) * (poly.v[1] - poly.v[0]) + v * (poly.v[2] - poly.v[3]);
-                    let dv = (1.0 - u) * (poly.v[3] - poly.v[0]) + u * (poly.v[2] - poly.v[1]);
-                    (poly.point(u, v), w * du.cross(dv).length())
-                })
-                .collect();
-            let total: f64 = pts.iter().map(|p| p.1).sum();
-            if total > 0.0 {
-                for p in &mut pts {
-                    p.1 /= total;
-                }
-            }
-            pts
-        }
-        PolyKind::Triangle => {
-            let rule = &quadrature::TRI_6;
-            rule.points.iter().zip(rule.weights).map(|(&(u, v), &w)| (poly.point(u, v), w)).collect()
-        }
+        PolyKind::Quad => &quadrature::QUAD_9,
+        PolyKind::Triangle => &quadrature::TRI_6,
     }
+}
+
+/// The mean of `f` over a surface element by its [`element_rule`].
+fn element_mean(poly: &crate::geom::Poly, mut f: impl FnMut(DVec3) -> f64) -> f64 {
+    let (mut sum, mut wsum) = (0.0, 0.0);
+    for (x, w) in quadrature::weighted_points(poly, element_rule(poly)) {
+        sum += w * f(x);
+        wsum += w;
+    }
+    if wsum > 0.0 { sum / wsum } else { 0.0 }
 }
 
 /// Sees the luminaires from surface points: illuminance with one shadow ray per luminaire.
@@ -224,7 +211,7 @@ fn needs_split(h: &Hierarchy, id: u32, light: &DirectLight<'_>) -> bool {
         }
         if depth < MAX_SHADOW_DEPTH && light.caster.is_some() {
             let mut seen = [false; 2];
-            for (x, _) in element_rule(&poly) {
+            for (x, _) in quadrature::weighted_points(&poly, element_rule(&poly)) {
                 let (v, occluded) = light.from_one(k, x, e.normal, polygon);
                 if v > 0.0 || occluded {
                     seen[usize::from(occluded)] = true;
@@ -255,53 +242,32 @@ pub fn prepare(h: &mut Hierarchy, caster: Option<&RayCaster>) {
     update_direct(h, caster);
 }
 
-/// Computes the direct illuminance of every surface element that has none yet (elements made since
-/// the last call), leaves by quadrature with shadow rays, inner surfaces as the area mean of their
-/// children.
+/// Computes the direct illuminance of every surface element made since the last call (leaves by
+/// quadrature with shadow rays), then every inner element's as the area mean of its children
+/// ([`crate::solve::area_means`]), so that every level carries the same power.
 pub fn update_direct(h: &mut Hierarchy, caster: Option<&RayCaster>) {
-    if h.luminaires.is_empty() {
-        return;
-    }
     use rayon::prelude::*;
-    let n = h.len();
-    let start = h.direct.len();
-    if start == n {
+    let (n, start) = (h.len(), h.direct.len());
+    if h.luminaires.is_empty() || start == n {
         return;
     }
-    h.direct.resize(n, f64::NAN);
     let luminaires = h.luminaires.clone();
     let light = DirectLight::new(&luminaires, caster, h.diagonal());
-    // Leaves made since the last call, and leaves that were subdivided since (their children are
-    // new; they become inner surfaces below).
     let hh: &Hierarchy = h;
-    let leaf_values: Vec<(u32, f64)> = (start as u32..n as u32)
+    let new: Vec<f64> = (start as u32..n as u32)
         .into_par_iter()
-        .filter_map(|id| {
+        .map(|id| {
             let e = hh.get(id);
-            let ElementKind::Surface { polygon, poly } = e.kind else { return None };
-            (e.n_children == 0).then(|| (id, element_rule(&poly).into_iter().map(|(x, w)| w * light.at(x, e.normal, polygon)).sum()))
+            match e.kind {
+                ElementKind::Surface { polygon, poly } if e.n_children == 0 => element_mean(&poly, |x| light.at(x, e.normal, polygon)),
+                _ => 0.0,
+            }
         })
         .collect();
-    for (id, v) in leaf_values {
-        h.direct[id as usize] = v;
-    }
-    // Inner surfaces: every surface with children, deepest first, as the area mean of its children
-    // (so that every level carries the same power).
-    let mut inner: Vec<u32> = (0..n as u32).filter(|&id| !h.get(id).is_cluster() && h.get(id).n_children > 0).collect();
-    inner.sort_by_key(|&id| std::cmp::Reverse(h.get(id).depth));
-    for id in inner {
-        let (sum, area) = h.children_of(id).iter().fold((0.0, 0.0), |(s, a), &c| {
-            let ce = h.get(c);
-            (s + ce.area * h.direct[c as usize], a + ce.area)
-        });
-        h.direct[id as usize] = if area > 0.0 { sum / area } else { 0.0 };
-    }
-    // Clusters carry nothing of their own.
-    for id in 0..n {
-        if h.direct[id].is_nan() {
-            h.direct[id] = 0.0;
-        }
-    }
+    let mut direct = std::mem::take(&mut h.direct);
+    direct.extend(new.into_iter().map(|v| [v; 3]));
+    crate::solve::area_means(h, &crate::solve::top_down(h), &mut direct);
+    h.direct = direct;
 }
 
 /// The luminous flux (lm) of all luminaires of `h` arriving on its surfaces (front sides), from the
@@ -311,5 +277,5 @@ pub fn flux_received(h: &Hierarchy) -> f64 {
     if h.direct.is_empty() {
         return 0.0;
     }
-    h.leaves().filter(|&l| !h.get(l).is_cluster()).map(|l| h.get(l).area * h.direct[l as usize]).sum()
+    h.leaves().filter(|&l| !h.get(l).is_cluster()).map(|l| h.get(l).area * h.direct[l as usize][1]).sum()
 }

@@ -401,9 +401,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     }
     let mut solution = solution.expect("at least one level solves");
     // The luminaires' direct light is part of what each surface receives.
-    for (irr, &d) in solution.irradiance.iter_mut().zip(&h.direct) {
-        for v in irr.iter_mut() {
-            *v += d;
+    for (irr, d) in solution.irradiance.iter_mut().zip(&h.direct) {
+        for c in 0..3 {
+            irr[c] += d[c];
         }
     }
     let error_estimate = levels.last().and_then(|l| l.error_estimate);

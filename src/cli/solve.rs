@@ -160,15 +160,12 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             file_grids.clone_from(&scene.grids);
             lit_scene = Some(plain);
         } else {
-            anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
-            anyhow::ensure!(args.points.is_none(), "--points applies to plain scenes, not to instanced ones (nor to --instances auto)");
-            anyhow::ensure!(args.picture.view.is_none(), "--view applies to plain scenes, not to instanced ones (nor to --instances auto)");
+            refuse_plain_only(args)?;
             return solve_instanced(args, &scene, None);
         }
     }
     if args.instances == Instances::Auto {
-        anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
-        anyhow::ensure!(args.points.is_none(), "--points applies to plain scenes, not to instanced ones (nor to --instances auto)");
+        refuse_plain_only(args)?;
         let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
         let t0 = Instant::now();
         let auto = radiosity::instancing::auto_instance(&scene, &radiosity::instancing::AutoOptions::default());
@@ -296,6 +293,15 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         };
         print_summary(&stats, &args.out, pictures);
     }
+    Ok(())
+}
+
+/// Refuses the options of plain solves for a solve by the instanced solver (an instanced scene file
+/// or `--instances auto`).
+fn refuse_plain_only(args: &SolveArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(args.time_for == 0.0, "--time-for applies to plain scenes, not to instanced ones");
+    anyhow::ensure!(args.points.is_none(), "--points applies to plain scenes, not to instanced ones (nor to --instances auto)");
+    anyhow::ensure!(args.picture.view.is_none(), "--view applies to plain scenes, not to instanced ones (nor to --instances auto)");
     Ok(())
 }
 

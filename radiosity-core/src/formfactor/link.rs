@@ -156,31 +156,15 @@ fn wholly_in_front(poly: &[DVec3], plane_pts: &[DVec3], n: DVec3, radius: f64) -
     some_in_front
 }
 
-/// Average over the receiver `rp` of the point-to-source form factor with a fixed rule.
+/// Average over the receiver `rp` of the point-to-source form factor with a fixed rule
+/// ([`quadrature::weighted_points`]).
 fn rule_average(rp: &Poly, rn: DVec3, sv: &[DVec3], sn: DVec3, rule: &quadrature::Rule) -> f64 {
-    let mut f = 0.0;
-    match rp.kind {
-        PolyKind::Quad => {
-            // Bilinear map: weight by the local Jacobian so non-parallelograms integrate correctly.
-            let mut wsum = 0.0;
-            for (&(u, v), &w) in rule.points.iter().zip(rule.weights) {
-                let du = (1.0 - v) * (rp.v[1] - rp.v[0]) + v * (rp.v[2] - rp.v[3]);
-                let dv = (1.0 - u) * (rp.v[3] - rp.v[0]) + u * (rp.v[2] - rp.v[1]);
-                let jac = du.cross(dv).length();
-                f += w * jac * point_polygon(rp.point(u, v), rn, sv, sn);
-                wsum += w * jac;
-            }
-            if wsum > 0.0 {
-                f /= wsum;
-            }
-        }
-        PolyKind::Triangle => {
-            for (&(u, v), &w) in rule.points.iter().zip(rule.weights) {
-                f += w * point_polygon(rp.point(u, v), rn, sv, sn);
-            }
-        }
+    let (mut f, mut wsum) = (0.0, 0.0);
+    for (x, w) in quadrature::weighted_points(rp, rule) {
+        f += w * point_polygon(x, rn, sv, sn);
+        wsum += w;
     }
-    f
+    if wsum > 0.0 { f / wsum } else { 0.0 }
 }
 
 /// Relative tolerance (times the plane element's radius) within which a point counts as on a

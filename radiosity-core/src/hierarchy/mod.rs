@@ -119,9 +119,9 @@ pub struct Hierarchy {
     /// The scene's luminaires (photometric point sources), whose light enters through
     /// [`Hierarchy::direct`].
     pub luminaires: Vec<crate::luminaire::Luminaire>,
-    /// Direct illuminance from the luminaires per element (area mean over a surface element; 0 for
-    /// clusters), filled by [`crate::luminaire::update_direct`]; empty without luminaires.
-    pub direct: Vec<f64>,
+    /// Direct illuminance from the luminaires per element and channel (the area mean over the
+    /// element), filled by [`crate::luminaire::update_direct`]; empty without luminaires.
+    pub direct: Vec<[f64; 3]>,
 }
 
 impl Hierarchy {
@@ -204,10 +204,10 @@ impl Hierarchy {
         if self.direct.is_empty() {
             return own;
         }
-        let d = self.direct.get(id as usize).copied().unwrap_or(0.0);
+        let d = self.direct.get(id as usize).copied().unwrap_or_default();
         let twin = self.twin[p];
-        let other = if twin == NONE { 0.0 } else { self.direct.get(twin as usize).copied().unwrap_or(0.0) };
-        std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d + self.transmittance[p][c] * other)
+        let other = if twin == NONE { [0.0; 3] } else { self.direct.get(twin as usize).copied().unwrap_or_default() };
+        std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d[c] + self.transmittance[p][c] * other[c])
     }
 
     /// The length of the diagonal of the scene's bounding box.

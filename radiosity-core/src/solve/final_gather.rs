@@ -34,12 +34,7 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
         irr[leaf as usize] = *g;
     }
     // Inner elements: area-weighted means, children before parents (reverse breadth-first order).
-    let mut order = vec![h.root];
-    let mut i = 0;
-    while i < order.len() {
-        order.extend_from_slice(h.children_of(order[i]));
-        i += 1;
-    }
+    let order = top_down(h);
     area_means(h, &order, &mut irr);
     for (&leaf, g) in leaves.iter().zip(gathered) {
         let p = h.get(leaf).polygon().expect("leaves are surfaces") as usize;
@@ -53,9 +48,22 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
     (b, irr)
 }
 
+/// Every element of `h`, parents before children (breadth-first from the root).
+#[must_use]
+pub fn top_down(h: &Hierarchy) -> Vec<ElementId> {
+    let mut order = Vec::with_capacity(h.len());
+    order.push(h.root);
+    let mut i = 0;
+    while i < order.len() {
+        order.extend_from_slice(h.children_of(order[i]));
+        i += 1;
+    }
+    order
+}
+
 /// Sets every inner element of `order` (parents before children) to the area-weighted mean of its
 /// children (children first: `order` is walked backwards).
-pub(super) fn area_means(h: &Hierarchy, order: &[ElementId], values: &mut [[f64; 3]]) {
+pub fn area_means(h: &Hierarchy, order: &[ElementId], values: &mut [[f64; 3]]) {
     for &e in order.iter().rev() {
         let kids = h.children_of(e);
         if kids.is_empty() {

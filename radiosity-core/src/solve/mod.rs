@@ -18,7 +18,7 @@ pub use direct::{direct_irradiance, direct_lower_bound, emitter_exchange};
 pub use estimate::{
     ESTIMATE_FLOOR, ESTIMATE_SAFETY, LevelHistory, NOISE_SIGMAS, ORDER_MAX, ORDER_MIN, richardson_estimate, visibility_noise,
 };
-pub use final_gather::final_gather;
+pub use final_gather::{area_means, final_gather, top_down};
 pub use gmres::{GmresResult, gmres};
 pub use leaf::{LEAF_OPERATOR_ENTRY_BYTES, LEAF_OPERATOR_MAX_ENTRIES, LeafCoefficients, LeafOperator, leaf_operator_entries};
 pub use operator::Operator;
