@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod daylight;
 pub mod formfactor;
 pub mod geom;
 pub mod hierarchy;
