@@ -162,6 +162,7 @@ fn room_with_chairs(n: usize, odd: &[ChairKind], seed: u64) -> SceneParts {
         camera: None,
         warnings: Default::default(),
         luminaires: Vec::new(),
+        distant: Vec::new(),
         units: Default::default(),
     };
     SceneParts { scene, odd: ranges }
@@ -282,6 +283,7 @@ fn symmetric_objects_are_matched_in_any_orientation() {
         camera: None,
         warnings: Default::default(),
         luminaires: Vec::new(),
+        distant: Vec::new(),
         units: Default::default(),
     };
     let result = auto_instance(&scene, &AutoOptions::default());

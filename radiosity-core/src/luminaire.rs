@@ -147,16 +147,6 @@ fn element_rule(poly: &crate::geom::Poly) -> &'static quadrature::Rule {
     }
 }
 
-/// The mean of `f` over a surface element by its [`element_rule`].
-fn element_mean(poly: &crate::geom::Poly, mut f: impl FnMut(DVec3) -> f64) -> f64 {
-    let (mut sum, mut wsum) = (0.0, 0.0);
-    for (x, w) in quadrature::weighted_points(poly, element_rule(poly)) {
-        sum += w * f(x);
-        wsum += w;
-    }
-    if wsum > 0.0 { sum / wsum } else { 0.0 }
-}
-
 /// Sees the luminaires from surface points: illuminance with one shadow ray per luminaire.
 pub struct DirectLight<'a> {
     luminaires: &'a [Luminaire],
@@ -193,9 +183,10 @@ impl<'a> DirectLight<'a> {
     }
 }
 
-/// Whether surface element `id` should be split for the luminaires' light: too large seen from a
-/// luminaire that lights it, or crossed by a shadow boundary.
-fn needs_split(h: &Hierarchy, id: u32, light: &DirectLight<'_>) -> bool {
+/// Whether surface element `id` should be split for the direct light: too large seen from a
+/// luminaire that lights it, or crossed by a shadow boundary of a luminaire or of a sharp distant
+/// source (the sun; not the sky's cells, whose shadows are soft).
+fn needs_split(h: &Hierarchy, id: u32, light: &DirectLight<'_>, distant: &crate::daylight::DistantLight<'_>) -> bool {
     let e = h.get(id);
     let ElementKind::Surface { polygon, poly } = e.kind else { return false };
     let depth = e.depth;
@@ -222,52 +213,87 @@ fn needs_split(h: &Hierarchy, id: u32, light: &DirectLight<'_>) -> bool {
             }
         }
     }
+    if depth < MAX_SHADOW_DEPTH && light.caster.is_some() {
+        for (k, s) in h.distant.iter().enumerate() {
+            if !s.sharp || s.on(e.normal).iter().all(|&v| v <= 0.0) {
+                continue;
+            }
+            let mut seen = [false; 2];
+            for (x, _) in quadrature::weighted_points(&poly, element_rule(&poly)) {
+                seen[usize::from(distant.from_one(k, x, e.normal, polygon).1)] = true;
+            }
+            if seen[0] && seen[1] {
+                return true;
+            }
+        }
+    }
     false
 }
 
-/// Subdivides the surfaces of `h` for the luminaires' light (see the module docs), then computes
-/// every element's direct illuminance ([`update_direct`]). Does nothing without luminaires.
+/// Subdivides the surfaces of `h` for the direct light (see the module docs), then computes every
+/// element's direct irradiance ([`update_direct`]). Does nothing without luminaires or distant
+/// sources.
 pub fn prepare(h: &mut Hierarchy, caster: Option<&RayCaster>) {
-    if h.luminaires.is_empty() {
+    if !h.has_direct_sources() {
         return;
     }
-    let luminaires = h.luminaires.clone();
+    let (luminaires, sources) = (h.luminaires.clone(), h.distant.clone());
     let light = DirectLight::new(&luminaires, caster, h.diagonal());
+    let distant = crate::daylight::DistantLight::new(&sources, caster, h.diagonal());
     let mut stack: Vec<u32> = (0..h.n_polygons).collect();
     while let Some(id) = stack.pop() {
-        if h.can_subdivide(id) && needs_split(h, id, &light) && h.subdivide(id) {
+        if h.can_subdivide(id) && needs_split(h, id, &light, &distant) && h.subdivide(id) {
             stack.extend_from_slice(h.children_of(id));
         }
     }
     update_direct(h, caster);
 }
 
-/// Computes the direct illuminance of every surface element made since the last call (leaves by
-/// quadrature with shadow rays), then every inner element's as the area mean of its children
+/// Computes the direct irradiance of every surface element made since the last call (leaves by
+/// quadrature with shadow rays: the luminaires' illuminance in every channel, the distant
+/// sources' per channel), then every inner element's as the area mean of its children
 /// ([`crate::solve::area_means`]), so that every level carries the same power.
 pub fn update_direct(h: &mut Hierarchy, caster: Option<&RayCaster>) {
     use rayon::prelude::*;
     let (n, start) = (h.len(), h.direct.len());
-    if h.luminaires.is_empty() || start == n {
+    if !h.has_direct_sources() || start == n {
         return;
     }
-    let luminaires = h.luminaires.clone();
+    let (luminaires, sources) = (h.luminaires.clone(), h.distant.clone());
     let light = DirectLight::new(&luminaires, caster, h.diagonal());
+    let distant = crate::daylight::DistantLight::new(&sources, caster, h.diagonal());
     let hh: &Hierarchy = h;
-    let new: Vec<f64> = (start as u32..n as u32)
+    let new: Vec<[f64; 3]> = (start as u32..n as u32)
         .into_par_iter()
         .map(|id| {
             let e = hh.get(id);
             match e.kind {
-                ElementKind::Surface { polygon, poly } if e.n_children == 0 => element_mean(&poly, |x| light.at(x, e.normal, polygon)),
-                _ => 0.0,
+                ElementKind::Surface { polygon, poly } if e.n_children == 0 => element_mean3(&poly, |x| {
+                    let lum = if luminaires.is_empty() { 0.0 } else { light.at(x, e.normal, polygon) };
+                    let d = if sources.is_empty() { [0.0; 3] } else { distant.at(x, e.normal, polygon) };
+                    d.map(|v| v + lum)
+                }),
+                _ => [0.0; 3],
             }
         })
         .collect();
     let mut direct = std::mem::take(&mut h.direct);
-    direct.extend(new.into_iter().map(|v| [v; 3]));
+    direct.extend(new);
     crate::solve::area_means(h, &crate::solve::top_down(h), &mut direct);
     h.direct = direct;
+}
+
+/// The mean of `f` per channel over a surface element by its [`element_rule`].
+fn element_mean3(poly: &crate::geom::Poly, mut f: impl FnMut(DVec3) -> [f64; 3]) -> [f64; 3] {
+    let (mut sum, mut wsum) = ([0.0; 3], 0.0);
+    for (x, w) in quadrature::weighted_points(poly, element_rule(poly)) {
+        let v = f(x);
+        for c in 0..3 {
+            sum[c] += w * v[c];
+        }
+        wsum += w;
+    }
+    if wsum > 0.0 { sum.map(|s| s / wsum) } else { [0.0; 3] }
 }
 
 /// The luminous flux (lm) of all luminaires of `h` arriving on its surfaces (front sides), from the

@@ -157,6 +157,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             let mut plain = radiosity::instancing::flatten(&scene, &radiosity::instancing::FlattenOptions::default())?;
             plain.luminaires = lighting.luminaires;
             plain.units = lighting.units;
+            plain.distant = lighting.bands.pack_distant(0);
             file_grids.clone_from(&scene.grids);
             lit_scene = Some(plain);
         } else {

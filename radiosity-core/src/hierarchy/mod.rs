@@ -119,8 +119,12 @@ pub struct Hierarchy {
     /// The scene's luminaires (photometric point sources), whose light enters through
     /// [`Hierarchy::direct`].
     pub luminaires: Vec<crate::luminaire::Luminaire>,
-    /// Direct illuminance from the luminaires per element and channel (the area mean over the
-    /// element), filled by [`crate::luminaire::update_direct`]; empty without luminaires.
+    /// The scene's distant sources (sun and sky), whose light enters through
+    /// [`Hierarchy::direct`] like the luminaires'.
+    pub distant: Vec<crate::daylight::DistantSource>,
+    /// Direct irradiance from the luminaires and distant sources per element and channel (the area
+    /// mean over the element), filled by [`crate::luminaire::update_direct`]; empty without
+    /// either.
     pub direct: Vec<[f64; 3]>,
 }
 
@@ -208,6 +212,12 @@ impl Hierarchy {
         let twin = self.twin[p];
         let other = if twin == NONE { [0.0; 3] } else { self.direct.get(twin as usize).copied().unwrap_or_default() };
         std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d[c] + self.transmittance[p][c] * other[c])
+    }
+
+    /// Whether light enters other than through emitting polygons: luminaires or distant sources.
+    #[must_use]
+    pub fn has_direct_sources(&self) -> bool {
+        !self.luminaires.is_empty() || !self.distant.is_empty()
     }
 
     /// The length of the diagonal of the scene's bounding box.

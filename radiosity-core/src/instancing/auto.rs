@@ -466,6 +466,7 @@ mod tests {
             camera: None,
             warnings: Default::default(),
             luminaires: Vec::new(),
+            distant: Vec::new(),
             units: Default::default(),
         }
     }

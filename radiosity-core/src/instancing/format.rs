@@ -13,23 +13,40 @@ use toml::Spanned;
 /// Name of the implicit root prototype made of the file's top-level content.
 pub const TOP_LEVEL_NAME: &str = "(scene)";
 
-/// A colour given as one number (grey) or three (RGB).
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+/// A colour given as one number (grey), three (RGB), or one per named band.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum ColorSpec {
     /// The same value in every channel.
     Grey(f64),
     /// Red, green, blue.
     Rgb([f64; 3]),
+    /// One value per band of the scene's `bands`.
+    Bands(Vec<f64>),
 }
 
 impl ColorSpec {
-    /// The three channels.
+    /// The three channels (the first three bands, zero past the last).
     #[must_use]
-    pub fn rgb(self) -> [f64; 3] {
+    pub fn rgb(&self) -> [f64; 3] {
         match self {
-            ColorSpec::Grey(x) => [x; 3],
-            ColorSpec::Rgb(c) => c,
+            ColorSpec::Grey(x) => [*x; 3],
+            ColorSpec::Rgb(c) => *c,
+            ColorSpec::Bands(v) => std::array::from_fn(|c| v.get(c).copied().unwrap_or(0.0)),
+        }
+    }
+
+    /// The values of `n` bands: one number for all, or exactly `n`.
+    pub fn values(&self, n: usize) -> Result<Vec<f64>, String> {
+        let v = match self {
+            ColorSpec::Grey(x) => return Ok(vec![*x; n]),
+            ColorSpec::Rgb(c) => c.to_vec(),
+            ColorSpec::Bands(v) => v.clone(),
+        };
+        if v.len() == n {
+            Ok(v)
+        } else {
+            Err(format!("{} values given, the scene has {n} bands (give one number or one per band)", v.len()))
         }
     }
 }
@@ -144,21 +161,28 @@ fn default_multiplier() -> f64 {
     1.0
 }
 
-/// What a scene file says about light and units beyond its geometry: `units` and `[[luminaire]]`.
+/// What a scene file says about light and units beyond its geometry: `units`, `[[luminaire]]`,
+/// `bands`, `[site]`, `[sun]` and `[sky]`.
 #[derive(Clone, Debug, Default)]
 pub struct Lighting {
     /// `units = "radiometric"` (default) or `"photometric"`.
     pub units: crate::photometry::Units,
     /// The luminaires, placed.
     pub luminaires: Vec<crate::luminaire::Luminaire>,
+    /// Bands (RGB unless declared) with the materials' values per band, and the daylight.
+    pub bands: super::bands::Bands,
 }
 
 impl Lighting {
     /// Whether the file asks for anything the instanced solver does not do (luminaires, photometric
-    /// units): such a scene is flattened and solved as a plain scene.
+    /// units, daylight, more than three bands): such a scene is flattened and solved as a plain
+    /// scene.
     #[must_use]
     pub fn needs_plain_solve(&self) -> bool {
-        !self.luminaires.is_empty() || self.units != crate::photometry::Units::Radiometric
+        !self.luminaires.is_empty()
+            || self.units != crate::photometry::Units::Radiometric
+            || self.bands.has_daylight()
+            || self.bands.packs() > 1
     }
 }
 
@@ -207,6 +231,14 @@ struct FileSpec {
     /// `[[grid]]`: calculation grids.
     #[serde(default)]
     grid: Vec<Spanned<crate::points::GridSpec>>,
+    #[serde(default)]
+    bands: Option<Spanned<Vec<String>>>,
+    #[serde(default)]
+    site: Option<super::bands::SiteSpec>,
+    #[serde(default)]
+    sun: Option<Spanned<super::bands::SunSpec>>,
+    #[serde(default)]
+    sky: Option<Spanned<super::bands::SkySpec>>,
 }
 
 /// Reads a scene file with instances. Prototype OBJ paths are relative to the file's folder.
@@ -236,7 +268,25 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
         InstancingError::at(path, line, if msg.is_empty() { "invalid TOML".to_owned() } else { msg.replace('\n', "; ") })
     })?;
 
-    // Materials, validated by the scene builder (same rules as OBJ / MGF materials).
+    // Bands and daylight first: the materials' values are per band.
+    let band_input = super::bands::BandsInput {
+        bands: spec.bands.as_ref().map(|b| b.get_ref().as_slice()),
+        site: spec.site.as_ref(),
+        sun: spec.sun.as_ref().map(|s| (s.get_ref(), line_of(s.span().start))),
+        sky: spec.sky.as_ref().map(|s| (s.get_ref(), line_of(s.span().start))),
+        materials: spec
+            .material
+            .iter()
+            .map(|m| {
+                let ms = m.get_ref();
+                (ms.reflectance.clone(), ms.transmittance.clone(), ms.emission.clone(), line_of(m.span().start))
+            })
+            .collect(),
+    };
+    let bands = super::bands::resolve(&band_input, path, spec.bands.as_ref().map_or(1, |b| line_of(b.span().start)))?;
+
+    // Materials, validated by the scene builder (same rules as OBJ / MGF materials); with bands,
+    // the first pack's values.
     let mut validator = SceneBuilder::new(path, "");
     let mut seen: Vec<&str> = Vec::with_capacity(spec.material.len());
     for m in &spec.material {
@@ -248,8 +298,8 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
         let mat = Material {
             name: ms.name.clone(),
             reflectance: ms.reflectance.rgb(),
-            emission: ms.emission.map_or([0.0; 3], ColorSpec::rgb),
-            transmittance: ms.transmittance.map_or([0.0; 3], ColorSpec::rgb),
+            emission: ms.emission.as_ref().map_or([0.0; 3], ColorSpec::rgb),
+            transmittance: ms.transmittance.as_ref().map_or([0.0; 3], ColorSpec::rgb),
             two_sided: ms.two_sided,
         };
         seen.push(&ms.name);
@@ -338,7 +388,15 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
         .map_err(|e| InstancingError::at(path, line, e.to_string()))?;
         luminaires.push(lum);
     }
-    Ok((scene, Lighting { units, luminaires }))
+    if !luminaires.is_empty() && bands.has_daylight() {
+        let span = spec.sun.as_ref().map(Spanned::span).or_else(|| spec.sky.as_ref().map(Spanned::span));
+        let line = span.map_or(1, |s| line_of(s.start));
+        return Err(InstancingError::at(path, line, "luminaires and daylight in one scene are not supported"));
+    }
+    if units == crate::photometry::Units::Photometric && bands.declared {
+        return Err(InstancingError::at(path, 1, "`bands` are radiometric: leave out `units = \"photometric\"`"));
+    }
+    Ok((scene, Lighting { units, luminaires, bands }))
 }
 
 struct Ctx<'a> {

@@ -59,6 +59,7 @@
 //! account for the transmittance.
 
 pub mod auto;
+pub mod bands;
 pub mod bench;
 pub mod caster;
 mod error;

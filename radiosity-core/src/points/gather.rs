@@ -248,6 +248,27 @@ impl<'a> PointGather<'a> {
                 out.h[c] += e;
             }
         }
+        // Distant sources (sun, sky cells): their beam, from the point's side of every surface it
+        // lies on, with one shadow ray each.
+        let far = crate::daylight::FAR_REL * self.scale;
+        for s in &self.h.distant {
+            if (0..sides.len).any(|k| sides.normals[k].dot(s.toward) >= 0.0) {
+                continue;
+            }
+            let e = s.on(n);
+            if e.iter().all(|&v| v <= 0.0) {
+                continue;
+            }
+            if let Some(caster) = self.caster {
+                out.rays += 1;
+                if !caster.segment_clear(origin, origin - s.toward * far, NONE, NONE) {
+                    continue;
+                }
+            }
+            for c in 0..3 {
+                out.h[c] += e[c];
+            }
+        }
         out
     }
 }

@@ -35,6 +35,7 @@ impl SceneBuilder {
                 camera: None,
                 warnings: SceneWarnings::default(),
                 luminaires: Vec::new(),
+                distant: Vec::new(),
                 units: crate::photometry::Units::Radiometric,
             },
             material_index: HashMap::new(),

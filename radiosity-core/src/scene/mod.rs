@@ -133,6 +133,8 @@ pub struct Scene {
     pub warnings: SceneWarnings,
     /// Photometric luminaires (see [`crate::luminaire`]); only in photometric scenes.
     pub luminaires: Vec<crate::luminaire::Luminaire>,
+    /// Distant sources: the sun and the sky's cells (see [`crate::daylight`]).
+    pub distant: Vec<crate::daylight::DistantSource>,
     /// Radiometric (W, W/m²) or photometric (lm, lx: every channel a luminous quantity).
     pub units: crate::photometry::Units,
 }
