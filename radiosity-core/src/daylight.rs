@@ -324,6 +324,86 @@ pub fn escape_cells() -> Vec<(DVec3, f64)> {
     sources.iter().map(|s| (-s.toward, s.irradiance[0] * (-s.toward.z))).map(|(d, w)| (DVec3::new(d.x, d.y, d.z), w)).collect()
 }
 
+/// Power (per channel) that the distant sources deliver to the surfaces: `Σ A·E_direct` over the
+/// leaves. Equal to what they bring in when nothing else lights the scene directly (no
+/// luminaires: a scene file refuses both).
+#[must_use]
+pub fn power_incident(h: &crate::hierarchy::Hierarchy) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    if h.direct.is_empty() {
+        return sum;
+    }
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        if e.polygon().is_some() {
+            for c in 0..3 {
+                sum[c] += e.area * h.direct[leaf as usize][c];
+            }
+        }
+    }
+    sum
+}
+
+/// Power (per channel) that leaves the scene: every surface leaf's `B·A` times its
+/// [`escape_fraction`], the [`ESCAPE_CELLS`] cells shared out over the leaf's quadrature points in
+/// turn. Independent of the links, so that `absorbed + escaped = incident + emitted` checks the
+/// solve.
+#[must_use]
+pub fn power_escaped(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster) -> [f64; 3] {
+    use rayon::prelude::*;
+    let cells = escape_cells();
+    let diag = h.diagonal();
+    let leaves: Vec<u32> = h.leaves().filter(|&l| h.get(l).polygon().is_some()).collect();
+    let per_leaf: Vec<[f64; 3]> = leaves
+        .par_iter()
+        .map(|&leaf| {
+            let e = h.get(leaf);
+            let b = radiosity[leaf as usize];
+            if b.iter().all(|&v| v <= 0.0) {
+                return [0.0; 3];
+            }
+            let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return [0.0; 3] };
+            let rule = match poly.kind {
+                crate::geom::PolyKind::Quad => &crate::geom::quadrature::QUAD_9,
+                crate::geom::PolyKind::Triangle => &crate::geom::quadrature::TRI_6,
+            };
+            let points: Vec<DVec3> = crate::geom::quadrature::weighted_points(poly, rule).map(|(x, _)| x).collect();
+            let mut f = 0.0;
+            for (k, cell) in cells.iter().enumerate() {
+                let x = points[k % points.len()];
+                f += escape_fraction(caster, std::slice::from_ref(cell), x, e.normal, polygon, diag);
+            }
+            b.map(|v| v * e.area * f)
+        })
+        .collect();
+    // Summed in leaf order: the same figure on every run.
+    per_leaf.iter().fold([0.0; 3], |a, b| std::array::from_fn(|c| a[c] + b[c]))
+}
+
+/// How far the power balance of a solve is from closing (see
+/// [`crate::pipeline::LevelReport::balance_gap`]): `solution.irradiance` is what the links bring,
+/// without the direct light.
+#[must_use]
+pub fn balance_gap(h: &crate::hierarchy::Hierarchy, solution: &crate::solve::Solution, caster: &RayCaster) -> f64 {
+    let incident = power_incident(h);
+    let escaped = power_escaped(h, &solution.radiosity, caster);
+    let (mut absorbed, mut emitted) = ([0.0; 3], [0.0; 3]);
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        let Some(p) = e.polygon() else { continue };
+        let p = p as usize;
+        let direct = h.direct.get(leaf as usize).copied().unwrap_or_default();
+        for c in 0..3 {
+            absorbed[c] += e.area * (1.0 - h.reflectance[p][c] - h.transmittance[p][c]) * (solution.irradiance[leaf as usize][c] + direct[c]);
+            emitted[c] += e.area * h.emission[p][c];
+        }
+    }
+    (0..3)
+        .filter(|&c| incident[c] + emitted[c] > 0.0)
+        .map(|c| ((absorbed[c] + escaped[c]) - (incident[c] + emitted[c])).abs() / (incident[c] + emitted[c]))
+        .fold(0.0, f64::max)
+}
+
 fn any_perpendicular(n: DVec3) -> DVec3 {
     if n.x.abs() < 0.9 { DVec3::X.cross(n) } else { DVec3::Y.cross(n) }
 }

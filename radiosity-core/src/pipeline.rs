@@ -218,7 +218,18 @@ pub struct LevelReport {
     pub error_estimate: Option<f64>,
     /// Wall time since the solve started, seconds.
     pub time_s: f64,
+    /// With daylight: how far the power balance is from closing, `|absorbed + escaped − incident
+    /// − emitted|` over `incident + emitted`, largest over channels
+    /// ([`crate::daylight::balance_gap`]); absent without.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub balance_gap: Option<f64>,
 }
+
+/// With daylight and a target error, the levels also run on until the power balance closes within
+/// this share of the target ([`LevelReport::balance_gap`]): the balance is measured apart from the
+/// links (the escape is ray cast), so it catches light the links lose, which the estimate, made
+/// from the links, cannot see.
+pub const BALANCE_SHARE_OF_TARGET: f64 = 0.5;
 
 /// The result of [`run`].
 pub struct Solved {
@@ -376,7 +387,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let last = level + 1 == n_levels || stats.refused_for_memory > 0;
         let estimate = (config.estimate_error && entries > 0 && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, config));
+        let balance_gap = (!h.distant.is_empty() && target_error.is_some()).then(|| crate::daylight::balance_gap(&h, &sol, &caster));
         let report = LevelReport {
+            balance_gap,
             threshold_scale: scale,
             elements: h.len(),
             leaves: h.leaves().count(),
@@ -389,7 +402,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         levels.push(report);
         solution = Some(sol);
         let reached = match (target_error, estimate) {
-            (Some(target), Some(e)) => e <= target,
+            (Some(target), Some(e)) => e <= target && balance_gap.is_none_or(|g| g <= BALANCE_SHARE_OF_TARGET * target),
             _ => false,
         };
         // Without an estimate (the leaf-resolution operator over its budget) a target cannot be

@@ -149,6 +149,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     // scene.
     let mut lit_scene = None;
     let mut file_grids = Vec::new();
+    let mut bands = None;
     if toml {
         let path = args.scene.as_ref().expect("checked above");
         let (scene, lighting) = radiosity::instancing::load_with_lighting(path)?;
@@ -158,6 +159,9 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             plain.luminaires = lighting.luminaires;
             plain.units = lighting.units;
             plain.distant = lighting.bands.pack_distant(0);
+            if lighting.bands.declared || lighting.bands.has_daylight() {
+                bands = Some(lighting.bands);
+            }
             file_grids.clone_from(&scene.grids);
             lit_scene = Some(plain);
         } else {
@@ -219,6 +223,26 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             runs += 1;
         }
     }
+    // Named bands beyond the first three: one more solve per pack of three.
+    let declared = bands.as_ref().filter(|b| b.declared);
+    anyhow::ensure!(
+        declared.is_none() || (points.is_none() && grids.is_empty()),
+        "--points, --grid, --work-plane and [[grid]] take RGB scenes for now, not scenes with named `bands`"
+    );
+    let mut pack_results = vec![output::polygon_results(&solved.hierarchy, &solved.solution)];
+    let mut pack_powers: Vec<output::BandPower> = Vec::new();
+    if let Some(b) = declared {
+        pack_powers.extend(&output::channel_powers(&solved)[..b.pack_range(0).len()]);
+        for k in 1..b.packs() {
+            reporter.phase(&format!("solving bands {}", b.names[b.pack_range(k)].join(", ")));
+            let mut pack = scene.clone();
+            pack.materials = b.pack_materials(k, &scene.materials);
+            pack.distant = b.pack_distant(k);
+            let s = pipeline::run(&pack, oracle.as_ref(), &config, &|p| reporter.event(p));
+            pack_results.push(output::polygon_results(&s.hierarchy, &s.solution));
+            pack_powers.extend(&output::channel_powers(&s)[..b.pack_range(k).len()]);
+        }
+    }
     let gathered = points.as_ref().map(|points| {
         reporter.phase(&format!("gathering at {} calculation points", points.len()));
         let t = Instant::now();
@@ -251,6 +275,17 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     stats.target_error = config.target_error;
+    if let Some(b) = &bands {
+        stats.sun.clone_from(&b.sun_report);
+    }
+    if let Some(b) = declared {
+        stats.set_band_powers(&b.names, &pack_powers, b.has_daylight());
+        stats.bands.clone_from(&b.names);
+        // Pictures show the first band in grey.
+        for v in solved.solution.radiosity.iter_mut().chain(solved.solution.irradiance.iter_mut()) {
+            *v = [v[0]; 3];
+        }
+    }
     // Photometric scenes show lux (irradiance) or lm/m² (radiosity); the values are already in lm.
     let false_colour = false_colour.map(|mut fc| {
         if scene.units == radiosity::photometry::Units::Photometric {
@@ -268,6 +303,16 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         false_colour,
     };
     output::write_solution(&args.out, &scene, &solved, &out_config)?;
+    if let Some(b) = declared {
+        let packs: Vec<&[output::PolygonResult]> = pack_results.iter().map(Vec::as_slice).collect();
+        for (name, write) in [
+            ("patches.csv", output::write_patches_csv_bands as fn(&mut output::atomic::AtomicFile, &_, &[String], &[&[output::PolygonResult]]) -> _),
+            ("groups.csv", output::write_groups_csv_bands),
+        ] {
+            let path = args.out.join(name);
+            output::atomic::write_file(&path, |w| write(w, &scene, &b.names, &packs)).with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
     if let Some((points, results, seconds)) = &gathered {
         let path = args.out.join("points.csv");
         output::atomic::write_file(&path, |w| output::write_points_csv_in(w, points, results, scene.units))
@@ -350,7 +395,27 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
     }
     let closed = if s.closed { "closed scene: each surface's light delivered whole" } else { "open scene" };
     let unit = s.units.power_label();
-    println!("power: emitted {:.6e} {unit}, absorbed {:.6e} {unit} (balance {:.5}; {closed})", s.power_emitted, s.power_absorbed, balance);
+    match (s.power_incident, s.power_escaped) {
+        (Some(incident), Some(escaped)) => {
+            println!(
+                "power: incident {incident:.6e} {unit} (sun and sky), emitted {:.6e} {unit}, absorbed {:.6e} {unit}, escaped {escaped:.6e} {unit} (balance {:.5}: absorbed + escaped over incident + emitted)",
+                s.power_emitted,
+                s.power_absorbed,
+                s.power_balance.unwrap_or(f64::NAN)
+            );
+            if !s.bands.is_empty() {
+                for (name, p) in s.power_by_band.iter().flatten() {
+                    println!("  band {name}: incident {:.6e}, absorbed {:.6e}, escaped {:.6e} {unit}", p.incident, p.absorbed, p.escaped);
+                }
+            }
+        }
+        _ => println!("power: emitted {:.6e} {unit}, absorbed {:.6e} {unit} (balance {:.5}; {closed})", s.power_emitted, s.power_absorbed, balance),
+    }
+    if let Some(sun) = &s.sun {
+        let az = sun.azimuth_deg.map_or(String::new(), |a| format!(", azimuth {a:.2} deg from north"));
+        let state = if sun.above_horizon { "" } else { " (below the horizon: no sun light)" };
+        println!("sun: zenith {:.2} deg{az}{state}", sun.zenith_deg);
+    }
     for l in &s.luminaires {
         let declared = l.declared_lm.map_or(String::new(), |d| format!(" (file declares {d:.1} lm)"));
         println!("luminaire {}: {:.1} lm{declared}", l.name, l.flux_lm);

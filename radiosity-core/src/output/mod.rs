@@ -16,7 +16,7 @@ mod stats;
 mod view;
 mod write;
 
-pub use csv::{PolygonResult, csv_field, polygon_results, write_groups_csv, write_patches_csv};
+pub use csv::{PolygonResult, csv_field, polygon_results, write_groups_csv, write_groups_csv_bands, write_patches_csv, write_patches_csv_bands};
 pub use falsecolor::{
     BACKGROUND, ColourScale, DEFAULT_LOG_DECADES, DEFAULT_MAX_AREA_SHARE, FalseColourConfig, LEGEND_MIN_HEIGHT, LEGEND_WIDTH, LINEAR_STEPS,
     PALETTE, Quantity, Scale, WATTS_PER_SQUARE_METRE, default_max, false_colour_image, format_label, nice_ceiling, palette,
@@ -29,7 +29,7 @@ pub use ply::write_ply;
 pub use points::{write_points_csv, write_points_csv_in};
 pub use render::{Frame, OUTSIDE_PREFERENCE, RenderConfig, ToneMap, default_view, frame, mean_brightness, render, render_frame, write_png};
 pub use smooth::CornerValues;
-pub use stats::{Stats, StatsTimes, peak_rss_bytes, power_balance};
+pub use stats::{BandPower, Stats, StatsTimes, channel_powers, peak_rss_bytes, power_balance};
 pub use view::{
     Candidate, INSIDE_CORNER_FRACTION, INSIDE_FOV_DEG, MAX_VIEW_ANGLE_DEG, OUTSIDE_ELEVATION_DEG, OUTSIDE_FOV_DEG, OUTSIDE_MARGIN, View,
     ViewError, ViewSpec, candidate_views, up_axis,

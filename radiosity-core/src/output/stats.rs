@@ -77,8 +77,25 @@ pub struct Stats {
     pub power_emitted: f64,
     /// Absorbed power Σ A·(1−ρ)·H (W or lm, same channel mean).
     pub power_absorbed: f64,
-    /// Absorbed over emitted power (null when nothing emits): 1 in a closed scene.
+    /// Absorbed over emitted power (null when nothing emits): 1 in a closed scene. With daylight,
+    /// `(absorbed + escaped) / (emitted + incident)`: 1 when the solve conserves energy.
     pub power_balance: Option<f64>,
+    /// Power the sun and sky deliver to the surfaces (W; null without daylight; same channel
+    /// mean as `power_absorbed`, or the sum over named bands).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub power_incident: Option<f64>,
+    /// Power leaving the scene (W; null without daylight; see [`crate::daylight::power_escaped`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub power_escaped: Option<f64>,
+    /// The scene's bands, when it names them (else the channels are r, g, b).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bands: Vec<String>,
+    /// Power per band (or per RGB channel with daylight): emitted, incident, absorbed, escaped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub power_by_band: Option<std::collections::BTreeMap<String, BandPower>>,
+    /// Where the sun is (scenes with a `[sun]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sun: Option<crate::instancing::bands::SunReport>,
     /// Sampled fraction of the light leaving the surfaces that escapes the scene (null when not
     /// measured; see [`crate::visibility::escape_fraction`]).
     pub escape_fraction: Option<f64>,
@@ -108,6 +125,69 @@ pub struct Stats {
     /// `--work-plane`; absent without).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grids: Option<std::collections::BTreeMap<String, crate::points::GridSummary>>,
+}
+
+/// The power of one band (or channel) in `stats.json` (W).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct BandPower {
+    /// Emitted by the polygons and luminaires.
+    pub emitted: f64,
+    /// Delivered to the surfaces by the sun and sky.
+    pub incident: f64,
+    /// Absorbed by the surfaces.
+    pub absorbed: f64,
+    /// Leaving the scene.
+    pub escaped: f64,
+}
+
+impl BandPower {
+    /// `(absorbed + escaped) / (emitted + incident)` with daylight, else `absorbed / emitted`.
+    #[must_use]
+    pub fn balance(&self, daylight: bool) -> Option<f64> {
+        let (out, inp) = if daylight { (self.absorbed + self.escaped, self.emitted + self.incident) } else { (self.absorbed, self.emitted) };
+        (inp > 0.0).then(|| out / inp)
+    }
+
+    /// The sum of `parts`.
+    #[must_use]
+    pub fn sum(parts: impl IntoIterator<Item = BandPower>) -> BandPower {
+        parts.into_iter().fold(BandPower::default(), |a, b| BandPower {
+            emitted: a.emitted + b.emitted,
+            incident: a.incident + b.incident,
+            absorbed: a.absorbed + b.absorbed,
+            escaped: a.escaped + b.escaped,
+        })
+    }
+}
+
+/// The power of each channel of a solve (escape and incidence measured only with daylight).
+#[must_use]
+pub fn channel_powers(solved: &crate::pipeline::Solved) -> [BandPower; 3] {
+    let h = &solved.hierarchy;
+    let mut out = [BandPower::default(); 3];
+    let lum: f64 = h.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum();
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        let Some(p) = e.polygon() else { continue };
+        let (rho, em, t) = (h.reflectance[p as usize], h.emission[p as usize], h.transmittance[p as usize]);
+        let hh = solved.solution.irradiance[leaf as usize];
+        for c in 0..3 {
+            out[c].emitted += e.area * em[c];
+            out[c].absorbed += e.area * (1.0 - rho[c] - t[c]) * hh[c];
+        }
+    }
+    if !h.distant.is_empty() {
+        let incident = crate::daylight::power_incident(h);
+        let escaped = crate::daylight::power_escaped(h, &solved.solution.radiosity, &solved.caster);
+        for c in 0..3 {
+            out[c].incident = incident[c];
+            out[c].escaped = escaped[c];
+        }
+    }
+    for o in &mut out {
+        o.emitted += lum;
+    }
+    out
 }
 
 /// One luminaire in `stats.json`.
@@ -171,7 +251,7 @@ impl Stats {
         let (load, output, total) = times;
         let h = &solved.hierarchy;
         let (power_emitted, power_absorbed, radiosity_mean) = power_balance(h, &solved.solution);
-        Stats {
+        let mut stats = Stats {
             scene: scene.name.clone(),
             oracle: oracle.to_string(),
             params,
@@ -204,6 +284,11 @@ impl Stats {
             power_emitted,
             power_absorbed,
             power_balance: (power_emitted > 0.0).then(|| power_absorbed / power_emitted),
+            power_incident: None,
+            power_escaped: None,
+            bands: Vec::new(),
+            power_by_band: None,
+            sun: None,
             escape_fraction: solved.escape_fraction.is_finite().then_some(solved.escape_fraction),
             closed: solved.closed,
             memory_limited: solved.memory_limited,
@@ -222,6 +307,27 @@ impl Stats {
                 })
                 .collect(),
             grids: None,
+        };
+        if !h.distant.is_empty() {
+            let per = channel_powers(solved);
+            stats.set_band_powers(&crate::output::csv::RGB, &per, true);
         }
+        stats
+    }
+
+    /// Sets the power figures from per-band powers: the scalars are the mean over RGB channels
+    /// (each carries the whole power) or the sum over named bands (each a part of the spectrum).
+    pub fn set_band_powers(&mut self, names: &[impl AsRef<str>], per: &[BandPower], daylight: bool) {
+        let total = BandPower::sum(per.iter().copied());
+        let rgb = names.len() == 3 && names.iter().zip(crate::output::csv::RGB).all(|(a, b)| a.as_ref() == b);
+        let scale = if rgb { 1.0 / 3.0 } else { 1.0 };
+        self.power_emitted = total.emitted * scale;
+        self.power_absorbed = total.absorbed * scale;
+        if daylight {
+            self.power_incident = Some(total.incident * scale);
+            self.power_escaped = Some(total.escaped * scale);
+        }
+        self.power_balance = total.balance(daylight);
+        self.power_by_band = Some(names.iter().map(|n| n.as_ref().to_owned()).zip(per.iter().copied()).collect());
     }
 }

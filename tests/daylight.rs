@@ -1,0 +1,200 @@
+//! Sun and sky through the whole command: scene files with `[sun]`, `[sky]` and `bands`, the power
+//! balance of open scenes, and the outputs per band.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// The power balance `(absorbed + escaped) / incident` of an open scene, measured independently of
+/// the links (the escape is ray cast), must close within this.
+const BALANCE_TOL: f64 = 0.005;
+/// Two packs with the same values agree to the linear solve's convergence (its iterations stop on
+/// the largest residual over a pack's three channels, so packs whose third channels differ stop
+/// at slightly different iterates).
+const PACK_TOL: f64 = 1e-9;
+/// Exact cases (an unobstructed plane) agree to rounding.
+const EXACT_TOL: f64 = 1e-9;
+
+fn run_cli(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radiosity")).args(args).current_dir(dir).output().expect("the binary runs")
+}
+
+fn solve(dir: &Path, scene: &str) -> serde_json::Value {
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    let out = run_cli(dir, &["solve", "scene.toml", "--quiet", "--no-image", "--out", "out"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_str(&std::fs::read_to_string(dir.join("out/stats.json")).unwrap()).unwrap()
+}
+
+fn csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(str::to_owned).collect();
+    (header, lines.map(|l| l.split(',').map(str::to_owned).collect()).collect())
+}
+
+fn column(header: &[String], name: &str) -> usize {
+    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+const GROUND: &str = r#"
+[[material]]
+name = "ground"
+reflectance = 0.3
+[[polygon]]
+material = "ground"
+vertices = [[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]]
+"#;
+
+#[test]
+fn an_open_plane_gets_exactly_the_sun_and_sky_and_reflects_its_share_away() {
+    // Sun 60 degrees from the zenith (cos 0.5): E = 800 * 0.5 + 100 = 500 W/m2 on 100 m2.
+    let dir = tempfile::tempdir().unwrap();
+    let s = solve(
+        dir.path(),
+        &format!(
+            "{GROUND}\n[sun]\ndirection = [{}, 0.0, -0.5]\ndirect_normal = 800\n[sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = 100\ndirections = 46\n",
+            0.75f64.sqrt()
+        ),
+    );
+    let incident = s["power_incident"].as_f64().unwrap();
+    assert!((incident - 50_000.0).abs() < EXACT_TOL * 50_000.0, "incident {incident}");
+    let absorbed = s["power_absorbed"].as_f64().unwrap();
+    assert!((absorbed - 0.7 * 50_000.0).abs() < EXACT_TOL * 50_000.0, "absorbed {absorbed}");
+    // Everything reflected leaves (nothing above the plane).
+    let escaped = s["power_escaped"].as_f64().unwrap();
+    assert!((escaped - 0.3 * 50_000.0).abs() < EXACT_TOL * 50_000.0, "escaped {escaped}");
+    assert!((s["power_balance"].as_f64().unwrap() - 1.0).abs() < EXACT_TOL);
+    let sun = &s["sun"];
+    assert!((sun["zenith_deg"].as_f64().unwrap() - 60.0).abs() < 1e-9, "{sun}");
+    let (header, rows) = csv(&dir.path().join("out/patches.csv"));
+    let h = rows[0][column(&header, "h_g")].parse::<f64>().unwrap();
+    assert!((h - 500.0).abs() < EXACT_TOL * 500.0, "irradiance {h}");
+}
+
+/// A leaf layer over a grey ground with a wall: shadows, interreflection, transmission, two bands.
+const SHADED: &str = r#"
+bands = ["PAR", "NIR"]
+[[material]]
+name = "ground"
+reflectance = [0.1, 0.3]
+[[material]]
+name = "wall"
+reflectance = [0.5, 0.6]
+[[material]]
+name = "leaf"
+reflectance = [0.10, 0.45]
+transmittance = [0.05, 0.40]
+two_sided = true
+[[polygon]]
+material = "ground"
+vertices = [[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]]
+[[box]]
+material = "wall"
+min = [2, -3, 0]
+max = [2.5, 3, 3]
+[[polygon]]
+material = "leaf"
+vertices = [[-1,-1,1],[1,-1,1.2],[1,1,1.2],[-1,1,1]]
+[[polygon]]
+material = "leaf"
+vertices = [[0,-1,1.6],[1.5,-1,1.9],[1.5,1,1.9],[0,1,1.6]]
+[sun]
+latitude = 43.6
+longitude = 3.9
+time = "2026-06-21T12:00:00+02:00"
+direct_normal = [400.0, 380.0]
+[sky]
+model = "cie-overcast"
+diffuse_horizontal = [100.0, 90.0]
+"#;
+
+#[test]
+fn shaded_two_band_scene_balances_and_reports_every_band() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = solve(dir.path(), SHADED);
+    assert_eq!(s["bands"], serde_json::json!(["PAR", "NIR"]));
+    let by_band = &s["power_by_band"];
+    let mut total_absorbed = 0.0;
+    for band in ["PAR", "NIR"] {
+        let p = &by_band[band];
+        let (inc, abs, esc) = (p["incident"].as_f64().unwrap(), p["absorbed"].as_f64().unwrap(), p["escaped"].as_f64().unwrap());
+        assert!(inc > 0.0 && abs > 0.0 && esc > 0.0, "{band}: {p}");
+        let balance = (abs + esc) / inc;
+        assert!((balance - 1.0).abs() < BALANCE_TOL, "{band}: balance {balance}");
+        total_absorbed += abs;
+    }
+    // Bands are parts of the spectrum: the scalars are sums over bands.
+    assert!((s["power_absorbed"].as_f64().unwrap() - total_absorbed).abs() < 1e-9 * total_absorbed);
+    // NIR: leaves reflect and transmit much more, so a larger share escapes than in PAR.
+    let share = |b: &str| by_band[b]["escaped"].as_f64().unwrap() / by_band[b]["incident"].as_f64().unwrap();
+    assert!(share("NIR") > 1.5 * share("PAR"), "escaped shares {} {}", share("PAR"), share("NIR"));
+    // patches.csv and groups.csv follow the bands; their absorbed powers add up to stats.json's.
+    let (header, rows) = csv(&dir.path().join("out/patches.csv"));
+    for name in ["b_PAR", "b_NIR", "h_PAR", "h_NIR", "absorbed_PAR", "absorbed_NIR"] {
+        column(&header, name);
+    }
+    assert!(!header.iter().any(|h| h == "b_r"));
+    let par: f64 = rows.iter().map(|r| r[column(&header, "absorbed_PAR")].parse::<f64>().unwrap()).sum();
+    let par_stats = by_band["PAR"]["absorbed"].as_f64().unwrap();
+    assert!((par - par_stats).abs() < 1e-9 * par_stats, "{par} vs {par_stats}");
+    let (gh, grows) = csv(&dir.path().join("out/groups.csv"));
+    assert_eq!(gh, ["group", "area", "absorbed_PAR", "absorbed_NIR"]);
+    let g: f64 = grows.iter().map(|r| r[2].parse::<f64>().unwrap()).sum();
+    assert!((g - par_stats).abs() < 1e-9 * par_stats);
+    // A leaf is two rows (its sides); each side absorbs (1 - rho - t) of what reaches it, so the
+    // lower leaf's underside absorbs less than its top.
+    let leaf_rows: Vec<&Vec<String>> = rows.iter().filter(|r| r[2] == "leaf").collect();
+    assert_eq!(leaf_rows.len(), 4);
+    let a = |r: &Vec<String>| r[column(&header, "absorbed_PAR")].parse::<f64>().unwrap();
+    assert!(a(leaf_rows[0]) > a(leaf_rows[1]), "top {} bottom {}", a(leaf_rows[0]), a(leaf_rows[1]));
+}
+
+#[test]
+fn four_bands_are_two_solves_that_agree_with_one() {
+    // Bands c, d repeat a, b: the second pack must give the first pack's answer.
+    let dir = tempfile::tempdir().unwrap();
+    let four = SHADED
+        .replace("bands = [\"PAR\", \"NIR\"]", "bands = [\"a\", \"b\", \"c\", \"d\"]")
+        .replace("[0.1, 0.3]", "[0.1, 0.3, 0.1, 0.3]")
+        .replace("[0.5, 0.6]", "[0.5, 0.6, 0.5, 0.6]")
+        .replace("[0.10, 0.45]", "[0.10, 0.45, 0.10, 0.45]")
+        .replace("[0.05, 0.40]", "[0.05, 0.40, 0.05, 0.40]")
+        .replace("[400.0, 380.0]", "[400.0, 380.0, 400.0, 380.0]")
+        .replace("[100.0, 90.0]", "[100.0, 90.0, 100.0, 90.0]");
+    let s = solve(dir.path(), &four);
+    let p = &s["power_by_band"];
+    for (x, y) in [("a", "c"), ("b", "d")] {
+        for key in ["incident", "absorbed", "escaped"] {
+            let (u, v) = (p[x][key].as_f64().unwrap(), p[y][key].as_f64().unwrap());
+            assert!((u - v).abs() <= PACK_TOL * u.abs(), "{x}/{y} {key}: {u} vs {v}");
+        }
+    }
+    let (header, rows) = csv(&dir.path().join("out/patches.csv"));
+    for r in &rows {
+        let (u, v): (f64, f64) = (r[column(&header, "absorbed_a")].parse().unwrap(), r[column(&header, "absorbed_c")].parse().unwrap());
+        assert!((u - v).abs() <= PACK_TOL * u.abs().max(1e-300), "{u} vs {v}");
+    }
+}
+
+#[test]
+fn bad_daylight_input_is_one_clear_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &str); 6] = [
+        ("bands = [\"PAR\", \"NIR\"]\n[[material]]\nname = \"m\"\nreflectance = [0.1, 0.2, 0.3]\n", "3 values given, the scene has 2 bands"),
+        ("bands = [\"PAR\", \"PAR\"]\n", "duplicate band `PAR`"),
+        ("bands = [\"PAR\"]\n[[material]]\nname = \"m\"\nreflectance = 0.6\ntransmittance = 0.5\n", "sum below 1"),
+        ("[sun]\ndirect_normal = 100\n", "give either `direction`, or `latitude`, `longitude` and `time`"),
+        ("[sun]\nlatitude = 43.6\nlongitude = 3.9\ntime = \"tomorrow\"\ndirect_normal = 100\n", "not RFC 3339"),
+        ("[sky]\ndiffuse_horizontal = 100\ndirections = 0\n", "sky directions 0"),
+    ];
+    for (i, (text, expected)) in cases.iter().enumerate() {
+        let name = format!("bad{i}.toml");
+        std::fs::write(dir.path().join(&name), format!("{text}{GROUND}")).unwrap();
+        let out = run_cli(dir.path(), &["solve", &name, "--quiet", "--out", "out"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name} was accepted");
+        assert!(err.contains(&name) && err.contains(expected), "{name}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{name}: {err}");
+        assert!(!err.contains("panicked"));
+    }
+}
