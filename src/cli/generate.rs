@@ -18,6 +18,8 @@ pub enum GenerateCommand {
         /// Output directory.
         #[arg(long, short, default_value = "tree")]
         out: PathBuf,
+        #[command(flatten)]
+        daylight: DaylightArgs,
     },
     /// A forest of trees of several ages on a square grid.
     Forest {
@@ -36,24 +38,122 @@ pub enum GenerateCommand {
         /// Output directory.
         #[arg(long, short, default_value = "forest")]
         out: PathBuf,
+        #[command(flatten)]
+        daylight: DaylightArgs,
     },
+}
+
+/// Sun and sky instead of the three lamps, in bands PAR and NIR.
+#[derive(clap::Args, Debug, Clone)]
+pub struct DaylightArgs {
+    /// Light the scene with the sun and the sky of a place and time instead of lamps, in two
+    /// bands, PAR (400-700 nm) and NIR (700-2500 nm), with typical leaf, bark and soil optical
+    /// properties per band.
+    #[arg(long)]
+    daylight: bool,
+    /// Latitude of the place, degrees north.
+    #[arg(long, default_value_t = 43.61, requires = "daylight", allow_negative_numbers = true)]
+    latitude: f64,
+    /// Longitude of the place, degrees east.
+    #[arg(long, default_value_t = 3.88, requires = "daylight", allow_negative_numbers = true)]
+    longitude: f64,
+    /// Date and time, RFC 3339 with its UTC offset.
+    #[arg(long, default_value = "2026-06-21T12:00:00+02:00", requires = "daylight")]
+    time: String,
+    /// Direct normal irradiance, PAR,NIR (W/m²).
+    #[arg(long, default_value = "400,380", requires = "daylight")]
+    direct_normal: String,
+    /// Diffuse horizontal irradiance, PAR,NIR (W/m²).
+    #[arg(long, default_value = "100,90", requires = "daylight")]
+    diffuse_horizontal: String,
+    /// Sky radiance model: uniform or cie-overcast.
+    #[arg(long, default_value = "cie-overcast", requires = "daylight")]
+    sky: String,
+    /// Sky cells (46 or 145 like the turtle skies, or any count).
+    #[arg(long, default_value_t = 145, requires = "daylight")]
+    sky_directions: u32,
+}
+
+/// Optical properties per band (PAR, NIR) of the generated materials: reflectance, transmittance.
+/// Typical green leaves absorb most PAR and scatter most NIR; bark and soil are darker in PAR.
+const BAND_MATERIALS: &str = r#"bands = ["PAR", "NIR"]
+
+[[material]]
+name = "bark"
+reflectance = [0.15, 0.35]
+
+[[material]]
+name = "leaf"
+reflectance = [0.10, 0.45]
+transmittance = [0.05, 0.40]
+two_sided = true
+
+[[material]]
+name = "ground"
+reflectance = [0.10, 0.25]
+
+[[material]]
+name = "light"
+reflectance = 0.0
+"#;
+
+impl DaylightArgs {
+    /// Two numbers `a,b`.
+    fn pair(what: &str, text: &str) -> anyhow::Result<[f64; 2]> {
+        let v: Vec<f64> = text.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| anyhow::anyhow!("--{what} `{text}`: give two numbers, PAR,NIR"))?;
+        anyhow::ensure!(v.len() == 2 && v.iter().all(|x| x.is_finite() && *x >= 0.0), "--{what} `{text}`: give two non-negative numbers, PAR,NIR");
+        Ok([v[0], v[1]])
+    }
+
+    /// Rewrites the written scene file: band materials, the sun and the sky instead of lamps.
+    fn apply(&self, path: &std::path::Path) -> anyhow::Result<()> {
+        let dni = Self::pair("direct-normal", &self.direct_normal)?;
+        let dhi = Self::pair("diffuse-horizontal", &self.diffuse_horizontal)?;
+        anyhow::ensure!(self.sky == "uniform" || self.sky == "cie-overcast", "--sky `{}`: uniform or cie-overcast", self.sky);
+        let text = std::fs::read_to_string(path)?;
+        let (start, end) = match (text.find("[[material]]"), text.find("[[prototype]]")) {
+            (Some(a), Some(b)) if a < b => (a, b),
+            _ => anyhow::bail!("{}: unexpected layout of a generated scene", path.display()),
+        };
+        let daylight = format!(
+            "[sun]\nlatitude = {}\nlongitude = {}\ntime = \"{}\"\ndirect_normal = [{:?}, {:?}]\n\n[sky]\nmodel = \"{}\"\ndiffuse_horizontal = [{:?}, {:?}]\ndirections = {}\n\n",
+            self.latitude, self.longitude, self.time, dni[0], dni[1], self.sky, dhi[0], dhi[1], self.sky_directions
+        );
+        let head = &text[..start];
+        let (first, rest) = head.split_at(head.find('\n').map_or(0, |i| i + 1));
+        let out = format!("{first}{rest}{BAND_MATERIALS}\n{daylight}{}", &text[end..]);
+        std::fs::write(path, out)?;
+        // Checks the result (sun position, sky cells) before saying it was written.
+        radiosity::instancing::load_with_lighting(path)?;
+        Ok(())
+    }
 }
 
 /// Runs a generator and prints where the scene was written.
 pub fn run(cmd: GenerateCommand) -> anyhow::Result<()> {
-    let (scene, out, stem) = match cmd {
-        GenerateCommand::Tree { age, seed, out } => {
+    let (mut scene, out, stem, daylight) = match cmd {
+        GenerateCommand::Tree { age, seed, out, daylight } => {
             anyhow::ensure!((1..=200).contains(&age), "--age must be between 1 and 200, got {age}");
-            (instancing::generate_tree(age, seed), out, "tree")
+            (instancing::generate_tree(age, seed), out, "tree", daylight)
         }
-        GenerateCommand::Forest { trees, min_age, max_age, seed, out } => {
+        GenerateCommand::Forest { trees, min_age, max_age, seed, out, daylight } => {
             anyhow::ensure!(trees >= 1, "--trees must be at least 1");
             anyhow::ensure!(min_age >= 1 && min_age <= max_age, "need 1 <= --min-age <= --max-age");
             let params = ForestParams { trees, min_age, max_age, seed, ..ForestParams::default() };
-            (instancing::generate_forest(&params), out, "forest")
+            (instancing::generate_forest(&params), out, "forest", daylight)
         }
     };
+    if daylight.daylight {
+        // The lamps go: the sun and the sky light the scene.
+        let light = scene.materials.iter().position(|m| m.name == instancing::plant::LIGHT).map(|i| i as u32);
+        for p in &mut scene.prototypes {
+            p.polygons.retain(|q| Some(q.material) != light);
+        }
+    }
     let path = instancing::write_scene(&scene, &out, stem)?;
+    if daylight.daylight {
+        daylight.apply(&path)?;
+    }
     let counts = scene.flattened_counts(true);
     let flat = counts.get(scene.root as usize).copied().unwrap_or(0);
     println!("wrote {} ({} prototypes, {flat} polygons flattened, two-sided leaves counted twice)", path.display(), scene.prototypes.len());
