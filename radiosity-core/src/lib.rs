@@ -10,10 +10,12 @@
 //! - [`solve`]: gather, push-pull, GMRES on the hierarchical operator → radiosity per element
 //! - [`output`]: `image.png`, `solution.ply`, `solution.glb`, `patches.csv`, `stats.json`
 //! - [`points`]: irradiance at calculation points, gathered from the solution → `points.csv`
+//! - [`canopy`]: random canopies of black leaves for validation against Beer's law
 //! - [`photometry`]: luminous intensity distributions of luminaires (IES LM-63, EULUMDAT)
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod canopy;
 pub mod daylight;
 pub mod formfactor;
 pub mod geom;
