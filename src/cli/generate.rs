@@ -1,6 +1,8 @@
-//! `radiosity generate {tree,forest}`: procedural poplar-like plants written as an instanced scene
-//! (TOML plus one OBJ per prototype).
+//! `radiosity generate {tree,forest,canopy}`: procedural poplar-like plants written as an instanced
+//! scene (TOML plus one OBJ per prototype), and random canopies of black leaves for validation
+//! against Beer's law (see `radiosity::canopy`).
 
+use radiosity::canopy::{self, CanopyParams, SceneFileOptions};
 use radiosity::instancing::{self, ForestParams};
 use std::path::PathBuf;
 
@@ -40,6 +42,50 @@ pub enum GenerateCommand {
         out: PathBuf,
         #[command(flatten)]
         daylight: DaylightArgs,
+    },
+    /// A random canopy: black square leaves with normals uniform over the sphere, placed at random
+    /// in a horizontal slab over a ground, lit by a sun and a uniform sky, with a calculation grid
+    /// `below` on the ground where Beer's law applies (the file's header says what it predicts).
+    Canopy {
+        /// Leaf area index (one-sided leaf area per ground area).
+        #[arg(long, default_value_t = 1.0)]
+        lai: f64,
+        /// Side of the square leaves.
+        #[arg(long, default_value_t = 0.1)]
+        leaf_size: f64,
+        /// Side of the square the leaf centres are spread over (centred on the origin).
+        #[arg(long, default_value_t = 10.0)]
+        extent: f64,
+        /// Thickness of the slab of leaf centres.
+        #[arg(long, default_value_t = 2.0)]
+        height: f64,
+        /// Height of the lowest leaf centres above the ground (at least the leaf's half-diagonal).
+        #[arg(long, default_value_t = 0.5)]
+        base: f64,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// The sun's zenith angle, degrees.
+        #[arg(long, default_value_t = 30.0)]
+        sun_zenith: f64,
+        /// The sun's azimuth, degrees clockwise from north (+y).
+        #[arg(long, default_value_t = 180.0)]
+        sun_azimuth: f64,
+        /// Direct normal irradiance, W/m² (0: no sun).
+        #[arg(long, default_value_t = 800.0)]
+        direct_normal: f64,
+        /// Diffuse horizontal irradiance of a uniform 145-cell sky, W/m² (0: no sky).
+        #[arg(long, default_value_t = 100.0)]
+        diffuse_horizontal: f64,
+        /// Ground reflectance.
+        #[arg(long, default_value_t = 0.0)]
+        ground_reflectance: f64,
+        /// Spacing of the calculation grid `below`.
+        #[arg(long, default_value_t = 0.25)]
+        grid_spacing: f64,
+        /// Output directory (canopy.toml and leaves.obj).
+        #[arg(long, short, default_value = "canopy")]
+        out: PathBuf,
     },
 }
 
@@ -100,8 +146,15 @@ reflectance = 0.0
 impl DaylightArgs {
     /// Two numbers `a,b`.
     fn pair(what: &str, text: &str) -> anyhow::Result<[f64; 2]> {
-        let v: Vec<f64> = text.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| anyhow::anyhow!("--{what} `{text}`: give two numbers, PAR,NIR"))?;
-        anyhow::ensure!(v.len() == 2 && v.iter().all(|x| x.is_finite() && *x >= 0.0), "--{what} `{text}`: give two non-negative numbers, PAR,NIR");
+        let v: Vec<f64> = text
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| anyhow::anyhow!("--{what} `{text}`: give two numbers, PAR,NIR"))?;
+        anyhow::ensure!(
+            v.len() == 2 && v.iter().all(|x| x.is_finite() && *x >= 0.0),
+            "--{what} `{text}`: give two non-negative numbers, PAR,NIR"
+        );
         Ok([v[0], v[1]])
     }
 
@@ -132,6 +185,35 @@ impl DaylightArgs {
 /// Runs a generator and prints where the scene was written.
 pub fn run(cmd: GenerateCommand) -> anyhow::Result<()> {
     let (mut scene, out, stem, daylight) = match cmd {
+        GenerateCommand::Canopy {
+            lai,
+            leaf_size,
+            extent,
+            height,
+            base,
+            seed,
+            sun_zenith,
+            sun_azimuth,
+            direct_normal,
+            diffuse_horizontal,
+            ground_reflectance,
+            grid_spacing,
+            out,
+        } => {
+            let params = CanopyParams { lai, leaf_size, extent, base, height, seed };
+            let c = canopy::random_leaves(&params)?;
+            let options = SceneFileOptions { ground_reflectance, sun_zenith, sun_azimuth, direct_normal, diffuse_horizontal, grid_spacing };
+            let path = canopy::write_scene_file(&c, &options, &out)?;
+            println!(
+                "wrote {} ({} leaves, LAI {:.4}; Beer's law below the canopy: {:.4} of the sun at {sun_zenith} degrees, {:.4} of a uniform sky)",
+                path.display(),
+                c.leaves.len(),
+                c.lai(),
+                canopy::beam_transmittance(c.lai(), sun_zenith.to_radians()),
+                canopy::diffuse_transmittance(c.lai())
+            );
+            return Ok(());
+        }
         GenerateCommand::Tree { age, seed, out, daylight } => {
             anyhow::ensure!((1..=200).contains(&age), "--age must be between 1 and 200, got {age}");
             (instancing::generate_tree(age, seed), out, "tree", daylight)
