@@ -65,9 +65,16 @@ const EXTENT: f64 = 336.0;
 const BASE: f64 = 5.0;
 const HEIGHT: f64 = 10.0;
 
-/// Zenith angles of the beam cases, degrees. 0° is measured by points 1/2 leaf apart, the others
-/// from [`AZIMUTHS`] azimuths by points 1 leaf apart, each farther than its margin from the edge.
+/// Zenith angles of the beam cases, degrees: 0° one sun, the others [`AZIMUTHS`] suns, measured
+/// at points farther than their margin from the edge.
 const ZENITHS: [f64; 3] = [0.0, 30.0, 60.0];
+
+/// The relative scatter the beam cases' points may add, as independent rays: 0.3%, well below
+/// the canopy's own (the points are spaced to give it, [`MAX_SPACING`] at most).
+const POINT_REL_SD: f64 = 0.003;
+
+/// Widest spacing of the beam cases' points, leaves.
+const MAX_SPACING: f64 = 2.0;
 
 /// Spacing of the points below each sky cell.
 const SKY_SPACING: f64 = 3.0;
@@ -126,9 +133,14 @@ fn cases(lai: f64, seed: u64) -> (Vec<Case>, usize) {
     let caster = RayCaster::new(&c.scene("canopy", None, Vec::new()).unwrap());
     let mut out = Vec::new();
     for zen in ZENITHS {
-        let (sources, spacing) = if zen == 0.0 { (suns(0.0, 1), 0.5 * S) } else { (suns(zen, AZIMUTHS), S) };
-        let t = transmitted(&c, &caster, &sources, spacing);
+        let sources = suns(zen, if zen == 0.0 { 1 } else { AZIMUTHS });
         let theory = canopy::beam_transmittance(c.lai(), zen.to_radians());
+        // Enough rays that their Bernoulli scatter, sqrt((1 − T)/(T·rays)) relative, is
+        // POINT_REL_SD: points closer where less light passes.
+        let rays = (1.0 - theory) / (theory * POINT_REL_SD * POINT_REL_SD);
+        let w = EXTENT - 2.0 * c.margin(zen.to_radians());
+        let spacing = (w * (sources.len() as f64 / rays).sqrt()).min(MAX_SPACING);
+        let t = transmitted(&c, &caster, &sources, spacing);
         out.push(Case { what: format!("sun at zenith {zen}° (exp(-G LAI/cos))"), measured: t, theory, tol: BEAM_REL_TOL });
     }
     let sky = daylight::sky(SkyModel::Uniform, [1.0; 3], 145, &Site::default()).unwrap();
