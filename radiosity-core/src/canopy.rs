@@ -103,6 +103,16 @@ impl CanopyParams {
         (self.lai * (self.extent / self.leaf_size).powi(2)).round() as usize
     }
 
+    /// How far from the canopy's edge a ground point must be for every ray toward zenith angle
+    /// `zenith` (radians, any azimuth) to cross the whole slab inside the canopy, past any leaf
+    /// whose centre is in the slab: `(base + height + d)·tan θ + d`, `d` the leaf's half-diagonal.
+    /// Infinite at and beyond the horizon.
+    #[must_use]
+    pub fn margin(&self, zenith: f64) -> f64 {
+        let d = self.half_diagonal();
+        if zenith.cos() <= 0.0 { f64::INFINITY } else { (self.base + self.height + d) * zenith.tan() + d }
+    }
+
     /// Half the diagonal of a leaf: its farthest reach from its centre.
     #[must_use]
     pub fn half_diagonal(&self) -> f64 {
@@ -162,15 +172,10 @@ impl Canopy {
         self.leaves.len() as f64 * self.params.leaf_size.powi(2) / self.params.extent.powi(2)
     }
 
-    /// How far from the canopy's edge a ground point must be for every ray toward zenith angle
-    /// `zenith` (radians, any azimuth) to cross the whole slab inside the canopy, past any leaf
-    /// whose centre is in the slab: `(base + height + d)·tan θ + d`, `d` the leaf's half-diagonal.
-    /// Infinite at and beyond the horizon.
+    /// [`CanopyParams::margin`] of its parameters.
     #[must_use]
     pub fn margin(&self, zenith: f64) -> f64 {
-        let p = &self.params;
-        let d = p.half_diagonal();
-        if zenith.cos() <= 0.0 { f64::INFINITY } else { (p.base + p.height + d) * zenith.tan() + d }
+        self.params.margin(zenith)
     }
 
     /// The canopy as a scene named `name`: the leaves (material `leaf`, black, one group) and an
