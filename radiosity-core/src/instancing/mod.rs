@@ -61,6 +61,7 @@
 pub mod auto;
 pub mod bench;
 pub mod caster;
+pub mod face_transfer;
 mod error;
 pub mod flatten;
 pub mod format;
