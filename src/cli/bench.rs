@@ -85,6 +85,10 @@ pub struct InstancingBenchArgs {
     /// direct light below the top level (0: the parallel beams carry it).
     #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().direct_samples, value_name = "N")]
     pub direct_samples: u32,
+    /// How closed instances re-emit the light they intercept: `uniform` (by the face it entered,
+    /// the mean albedo) or `directional` (by the faces the prototype's face transfer matrix says).
+    #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().proxy_emission, value_name = "MODE")]
+    pub proxy_emission: radiosity::instancing::ProxyEmission,
     /// Internal: run one method (`full` or `instanced`) and write its per-polygon means here.
     #[arg(long, hide = true, num_args = 2, value_names = ["METHOD", "FILE"])]
     pub child: Vec<String>,
@@ -449,7 +453,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     let instance_levels: radiosity::instancing::InstanceLevels =
         args.instance_levels.parse().map_err(|e: String| anyhow::anyhow!("--instance-levels: {e}"))?;
     let config = |eps: f64| {
-        let mut config = InstancedConfig { instance_levels, direct_samples: args.direct_samples, ..InstancedConfig::default() };
+        let mut config = InstancedConfig {
+            instance_levels,
+            direct_samples: args.direct_samples,
+            proxy_emission: args.proxy_emission,
+            ..InstancedConfig::default()
+        };
         config.bf.eps = eps;
         config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
         config
@@ -487,6 +496,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
             .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string()])
             .args(["--instance-levels", &args.instance_levels])
             .args(["--direct-samples", &args.direct_samples.to_string()])
+            .args(["--proxy-emission", &args.proxy_emission.to_string()])
             .args(extra)
             .output()
             .with_context(|| format!("running {}", exe.display()))?;
