@@ -73,9 +73,9 @@ impl FaceTally {
         if let Some((exit, weight)) = escape
             && exit < BOX_FACES
         {
-            for c in 0..3 {
-                if weight[c].is_finite() {
-                    self.escaped[entry][exit][c] += w * weight[c];
+            for (e, x) in self.escaped[entry][exit].iter_mut().zip(weight) {
+                if x.is_finite() {
+                    *e += w * x;
                 }
             }
         }

@@ -20,8 +20,11 @@ use crate::solve::Solution;
 /// `i` of its box with their coefficients `T[i][j]·Aᵢ / Aⱼ` per channel.
 #[derive(Default)]
 pub(super) struct CrossTerms {
-    rows: Vec<(u32, [(u32, [f64; 3]); BOX_FACES - 1])>,
+    rows: Vec<CrossRow>,
 }
+
+/// A proxy face (polygon index) and the other faces of its box with their coefficients.
+type CrossRow = (u32, [(u32, [f64; 3]); BOX_FACES - 1]);
 
 impl CrossTerms {
     /// The terms of the boxes whose faces are `faces[slot] = polygon index per face` (a box whose
@@ -39,7 +42,7 @@ impl CrossTerms {
             let area = |f: usize| polys.get(box_faces[f] as usize).map_or(0.0, Poly::area);
             for j in 0..BOX_FACES {
                 let a_j = area(j);
-                if !(a_j > 0.0) {
+                if a_j.is_nan() || a_j <= 0.0 {
                     continue;
                 }
                 let mut from = [(0u32, [0.0; 3]); BOX_FACES - 1];
@@ -60,7 +63,7 @@ impl CrossTerms {
 
     /// Approximate heap bytes.
     pub(super) fn bytes(&self) -> usize {
-        self.rows.len() * std::mem::size_of::<(u32, [(u32, [f64; 3]); BOX_FACES - 1])>()
+        self.rows.len() * std::mem::size_of::<CrossRow>()
     }
 
     /// Adds to `emission` (per polygon) each proxy face's cross-face emission, from the
