@@ -85,6 +85,14 @@ pub struct InstancingBenchArgs {
     /// direct light below the top level (0: the parallel beams carry it).
     #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().direct_samples, value_name = "N")]
     pub direct_samples: u32,
+    /// How closed instances re-emit the light they intercept: `uniform` (by the face it entered,
+    /// the mean albedo) or `directional` (by the faces the prototype's face transfer matrix says).
+    #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().proxy_emission, value_name = "MODE")]
+    pub proxy_emission: radiosity::instancing::ProxyEmission,
+    /// Keep the full solve at `--eps` in this file (its figures in FILE.json) and, when it holds
+    /// one of the same tree and threshold, reuse it instead of solving again.
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
     /// Internal: run one method (`full` or `instanced`) and write its per-polygon means here.
     #[arg(long, hide = true, num_args = 2, value_names = ["METHOD", "FILE"])]
     pub child: Vec<String>,
@@ -449,7 +457,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     let instance_levels: radiosity::instancing::InstanceLevels =
         args.instance_levels.parse().map_err(|e: String| anyhow::anyhow!("--instance-levels: {e}"))?;
     let config = |eps: f64| {
-        let mut config = InstancedConfig { instance_levels, direct_samples: args.direct_samples, ..InstancedConfig::default() };
+        let mut config = InstancedConfig {
+            instance_levels,
+            direct_samples: args.direct_samples,
+            proxy_emission: args.proxy_emission,
+            ..InstancedConfig::default()
+        };
         config.bf.eps = eps;
         config.cache_dir = Some(std::env::temp_dir().join("radiosity-instancing-cache"));
         config
@@ -482,11 +495,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     }
     let exe = std::env::current_exe().context("locating this executable")?;
     let dir = std::env::temp_dir();
-    let run_child = |extra: &[String]| -> anyhow::Result<BenchRow> {
+    let run_child_with = |emission: radiosity::instancing::ProxyEmission, extra: &[String]| -> anyhow::Result<BenchRow> {
         let o = Command::new(&exe)
             .args(["bench", "instancing", "--age", &args.age.to_string(), "--seed", &args.seed.to_string()])
             .args(["--instance-levels", &args.instance_levels])
             .args(["--direct-samples", &args.direct_samples.to_string()])
+            .args(["--proxy-emission", &emission.to_string()])
             .args(extra)
             .output()
             .with_context(|| format!("running {}", exe.display()))?;
@@ -494,25 +508,57 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
         let text = String::from_utf8_lossy(&o.stdout);
         serde_json::from_str(text.lines().last().unwrap_or("")).context("unreadable child result")
     };
+    let run_child = |extra: &[String]| run_child_with(args.proxy_emission, extra);
+    // The other proxy emission, solved at --eps only, so that the table shows both.
+    let other_emission = match args.proxy_emission {
+        radiosity::instancing::ProxyEmission::Uniform => radiosity::instancing::ProxyEmission::Directional,
+        radiosity::instancing::ProxyEmission::Directional => radiosity::instancing::ProxyEmission::Uniform,
+    };
     // Every threshold, finest first: both methods, each in its own process (peak RSS per process).
     let mut thresholds = vec![args.eps];
     thresholds.extend(args.sweep.iter().copied().filter(|&e| e != args.eps));
     let mut points: Vec<(BenchRow, f64, f64, usize)> = Vec::new();
     let mut reference = None;
     for (k, &eps) in thresholds.iter().enumerate() {
-        for method in ["full", "instanced"] {
-            if !args.json {
-                eprintln!("tree age {}: {method} solve at eps {eps} ...", args.age);
-            }
-            let file = dir.join(format!("radiosity-bench-instancing-{method}-{}.bin", std::process::id()));
-            let row = run_child(&["--eps".into(), eps.to_string(), "--child".into(), method.into(), file.display().to_string()])?;
-            let means = load_means(&file)?;
-            let _ = std::fs::remove_file(&file);
-            if k == 0 && method == "full" {
+        let methods: &[&str] = if k == 0 { &["full", "instanced", "other"] } else { &["full", "instanced"] };
+        for &method in methods {
+            if k == 0
+                && method == "full"
+                && let Some(kept) = args.reference.as_deref()
+                && let Some((row, means)) = super::bench_reference::load(kept, args.age, args.seed, eps)?
+            {
+                if !args.json {
+                    eprintln!("tree age {}: full solve at eps {eps} read from {}", args.age, kept.display());
+                }
                 reference = Some(means);
                 points.push((row, 0.0, 0.0, 0));
                 continue;
             }
+            let (emission, child) = match method {
+                "other" => (other_emission, "instanced"),
+                m => (args.proxy_emission, m),
+            };
+            if !args.json {
+                let proxies = if child == "instanced" { format!(" ({emission} proxies)") } else { String::new() };
+                eprintln!("tree age {}: {child} solve{proxies} at eps {eps} ...", args.age);
+            }
+            let file = dir.join(format!("radiosity-bench-instancing-{method}-{}.bin", std::process::id()));
+            let mut row =
+                run_child_with(emission, &["--eps".into(), eps.to_string(), "--child".into(), child.into(), file.display().to_string()])?;
+            if method == "other" {
+                row.method = format!("inst-{emission}");
+            }
+            let means = load_means(&file)?;
+            if k == 0 && method == "full" {
+                if let Some(kept) = args.reference.as_deref() {
+                    super::bench_reference::keep(&file, kept, &row, args.age, args.seed, eps)?;
+                }
+                let _ = std::fs::remove_file(&file);
+                reference = Some(means);
+                points.push((row, 0.0, 0.0, 0));
+                continue;
+            }
+            let _ = std::fs::remove_file(&file);
             let reference = reference.as_ref().expect("the full solve at --eps runs first");
             let (worst, mean) = relative_error(reference, &means);
             points.push((row, worst, mean, polygons_above(reference, &means, ERROR_COUNT_FRACTION)));
@@ -553,6 +599,7 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
         .with_context(|| format!("{}: cannot write", svg_path.display()))?;
 
     let (rf, ri, worst, mean, above) = (&points[0].0, &points[1].0, points[1].1, points[1].2, points[1].3);
+    let (ro, worst_o, mean_o, above_o) = (&points[2].0, points[2].1, points[2].2, points[2].3);
     if args.json {
         let doc = serde_json::json!({
             "tree": {
@@ -561,9 +608,15 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
                 "eps": args.eps,
                 "full": {"time_s": rf.seconds, "peak_rss_bytes": rf.peak_rss_bytes, "links": rf.links},
                 "instanced": {"time_s": ri.seconds, "peak_rss_bytes": ri.peak_rss_bytes, "links": ri.links},
+                "proxy_emission": args.proxy_emission.to_string(),
                 "error_pct_of_max": 100.0 * worst,
                 "error_mean_pct_of_max": 100.0 * mean,
                 "polygons_above_3pct": above,
+                "other_proxy_emission": {
+                    "proxy_emission": other_emission.to_string(), "time_s": ro.seconds, "peak_rss_bytes": ro.peak_rss_bytes,
+                    "links": ro.links, "error_pct_of_max": 100.0 * worst_o, "error_mean_pct_of_max": 100.0 * mean_o,
+                    "polygons_above_3pct": above_o,
+                },
             },
             "error_time": points.iter().map(|(r, w, m, a)| serde_json::json!({
                 "method": r.method, "eps": r.eps, "time_s": r.seconds, "peak_rss_bytes": r.peak_rss_bytes,
@@ -579,12 +632,12 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
     }
     println!("tree age {} seed {}, {} polygons (two-sided leaves as pairs), eps {}", args.age, args.seed, rf.polygons, args.eps);
     println!(
-        "{:<10} {:>7} {:>10} {:>10} {:>10} {:>8} {:>10} {:>10} {:>8}",
+        "{:<16} {:>7} {:>10} {:>10} {:>10} {:>8} {:>10} {:>10} {:>8}",
         "method", "eps", "time_s", "peak_MB", "links", "solves", "err_max%", "err_mean%", "n>3%"
     );
     for (r, w, m, a) in &points {
         println!(
-            "{:<10} {:>7} {:>10.3} {:>10.1} {:>10} {:>8} {:>10.2} {:>10.3} {:>8}",
+            "{:<16} {:>7} {:>10.3} {:>10.1} {:>10} {:>8} {:>10.2} {:>10.3} {:>8}",
             r.method,
             r.eps,
             r.seconds,
@@ -597,13 +650,21 @@ fn bench_instancing(args: &InstancingBenchArgs) -> anyhow::Result<()> {
         );
     }
     println!(
-        "instanced vs full at eps {}: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity ({above} of {} polygons above 3%)",
+        "instanced ({} proxies) vs full at eps {}: {:.2}x faster, {:.2}x less peak memory, error max {:.2}% / mean {:.3}% of the full solution's largest radiosity ({above} of {} polygons above 3%)",
+        args.proxy_emission,
         args.eps,
         rf.seconds / ri.seconds.max(1e-9),
         rf.peak_rss_bytes as f64 / ri.peak_rss_bytes.max(1) as f64,
         100.0 * worst,
         100.0 * mean,
         rf.polygons
+    );
+    println!(
+        "with {other_emission} proxies: {:.3} s, {:.1} MB, error max {:.2}% / mean {:.3}% ({above_o} polygons above 3%)",
+        ro.seconds,
+        ro.peak_rss_bytes as f64 / 1e6,
+        100.0 * worst_o,
+        100.0 * mean_o
     );
     if !forests.is_empty() {
         println!("{:<8} {:>12} {:>10} {:>10} {:>12}", "trees", "polygons", "time_s", "peak_MB", "links");

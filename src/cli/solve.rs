@@ -53,6 +53,11 @@ pub struct SolveArgs {
     /// the parallel beams into each instance, with the instance's average visibility).
     #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().direct_samples, value_name = "N")]
     pub direct_samples: u32,
+    /// Instanced scenes: how a closed instance re-emits the light it intercepts: `directional`
+    /// (through the faces of its box its prototype's face transfer matrix says) or `uniform`
+    /// (back through the face it entered, with the mean albedo: the paper's proxy).
+    #[arg(long, default_value_t = radiosity::instancing::InstancedConfig::default().proxy_emission, value_name = "MODE")]
+    pub proxy_emission: radiosity::instancing::ProxyEmission,
     /// Plain scenes: solve again (build, refine, solve; same results) until this many seconds have
     /// passed, and report each phase's fastest time in `stats.json` (`time_s.runs` says how many
     /// solves; outputs come from the first). For timing small scenes on a noisy machine.
@@ -485,6 +490,7 @@ fn solve_instanced(
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     config.instance_levels = args.instance_levels;
     config.direct_samples = args.direct_samples;
+    config.proxy_emission = args.proxy_emission;
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
     let stats = instancing::solve_instanced(scene, &config, &mut sink)?;

@@ -62,6 +62,7 @@ pub mod auto;
 pub mod bands;
 pub mod bench;
 pub mod caster;
+pub mod face_transfer;
 mod error;
 pub mod flatten;
 pub mod format;
@@ -83,6 +84,7 @@ pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, 
 pub use output::{StreamedOutput, StreamedSummary};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};
 pub use solver::{
-    InstanceLevels, InstancedConfig, InstancedStats, Leaf, PolygonInfo, PolygonMeans, RadiositySink, solve_full, solve_instanced,
+    InstanceLevels, InstancedConfig, InstancedStats, Leaf, PolygonInfo, PolygonMeans, ProxyEmission, RadiositySink, solve_full,
+    solve_instanced,
 };
 pub use write::write_scene;

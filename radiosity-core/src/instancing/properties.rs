@@ -18,6 +18,7 @@
 //! one-sided and two-sided-as-pairs surfaces, no transmittance).
 
 use super::InstancingError;
+use super::face_transfer::{FaceTally, FaceTransfer, entry_face, exit_face};
 use super::flatten::{FlattenOptions, flatten_prototype};
 use super::model::{InstancedScene, PrototypeId, Transform};
 use crate::geom::{Aabb, DVec3};
@@ -30,7 +31,8 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 /// Version of the cached file layout and of the estimators; part of the cache key.
-pub const CACHE_VERSION: u32 = 1;
+/// 2: entries hold the face transfer matrix ([`super::face_transfer`]).
+pub const CACHE_VERSION: u32 = 2;
 /// Most bounces of one random walk (weights are negligible long before).
 pub const MAX_BOUNCES: u32 = 256;
 /// Offset of a bounced ray's origin off the surface, relative to the prototype's box diagonal.
@@ -94,6 +96,10 @@ pub struct RadiativeProperties {
     pub phase: Vec<[f64; 3]>,
     /// Total surface area of the prototype's polygons, m².
     pub surface_area: f64,
+    /// The face transfer matrix of the bounding box, row-major per channel (see
+    /// [`super::face_transfer`]); empty in entries written before it was measured.
+    #[serde(default)]
+    pub face_transfer: Vec<[f64; 3]>,
 }
 
 impl RadiativeProperties {
@@ -117,6 +123,13 @@ impl RadiativeProperties {
         std::array::from_fn(|c| {
             if total > 0.0 { self.albedo.iter().zip(&self.effective_area).map(|(al, a)| al[c] * a).sum::<f64>() / total } else { 0.0 }
         })
+    }
+
+    /// The face transfer matrix; the uniform one of [`Self::mean_albedo`] when none was stored
+    /// or the stored one is malformed.
+    #[must_use]
+    pub fn face_transfer(&self) -> FaceTransfer {
+        FaceTransfer::from_entries(&self.face_transfer).unwrap_or_else(|| FaceTransfer::uniform(self.mean_albedo()))
     }
 
     /// Index of the sampled direction closest to `dir`.
@@ -266,9 +279,11 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
         albedo: Vec::with_capacity(dirs.len()),
         phase: Vec::new(),
         surface_area,
+        face_transfer: Vec::new(),
     };
+    let mut tally = FaceTally::default();
     for (k, &w) in dirs.iter().enumerate() {
-        let (tau, walk_albedo) = trace_direction(flat, &caster, &bounds, w, config, k as u32);
+        let (tau, walk_albedo) = trace_direction(flat, &caster, &bounds, w, config, k as u32, &mut tally);
         let a_box = box_projected_area(&bounds, w);
         let a_eff = (1.0 - tau) * a_box;
         let albedo = match config.method {
@@ -288,6 +303,7 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
         .zip(&props.effective_area)
         .map(|(al, a)| al.map(|x| if integral > 0.0 { PI * x * a / integral } else { 0.0 }))
         .collect();
+    props.face_transfer = tally.finish(props.mean_albedo()).0;
     props
 }
 
@@ -333,8 +349,17 @@ pub(super) fn cosine_dir_from(n: DVec3, r1: f64, r2: f64) -> DVec3 {
     (u * (r * phi.cos()) + v * (r * phi.sin()) + n * (1.0 - r1).max(0.0).sqrt()).normalize_or_zero()
 }
 
-/// τ and the random-walk escape albedo for light arriving from `w` (rays travel along −w).
-fn trace_direction(flat: &Scene, caster: &RayCaster, bounds: &Aabb, w: DVec3, config: &PropertyConfig, k: u32) -> (f64, [f64; 3]) {
+/// τ and the random-walk escape albedo for light arriving from `w` (rays travel along −w); each
+/// intercepted ray's power, entry face and exit face go to `tally`.
+fn trace_direction(
+    flat: &Scene,
+    caster: &RayCaster,
+    bounds: &Aabb,
+    w: DVec3,
+    config: &PropertyConfig,
+    k: u32,
+    tally: &mut FaceTally,
+) -> (f64, [f64; 3]) {
     let d = -w;
     let (u, v) = basis(d);
     let c = bounds.center();
@@ -348,6 +373,8 @@ fn trace_direction(flat: &Scene, caster: &RayCaster, bounds: &Aabb, w: DVec3, co
         vmax = vmax.max(p.dot(v));
     }
     let strata = (f64::from(config.rays_per_direction.max(1))).sqrt().ceil() as u32;
+    // Power per ray under unit irradiance: the shadow rectangle's area over the rays.
+    let ray_power = (umax - umin) * (vmax - vmin) / f64::from(strata * strata);
     let mut rng = Rng::for_link(config.seed, 0x7A0, k);
     let (mut n_box, mut n_pass, mut n_hit) = (0u64, 0u64, 0u64);
     let mut escaped = [0.0; 3];
@@ -363,9 +390,15 @@ fn trace_direction(flat: &Scene, caster: &RayCaster, bounds: &Aabb, w: DVec3, co
             None => n_pass += 1,
             Some((t, p)) => {
                 n_hit += 1;
-                let e = walk(flat, caster, origin + d * t, d, p, diag, &mut rng);
-                for ch in 0..3 {
-                    escaped[ch] += e[ch];
+                let out = walk(flat, caster, origin + d * t, d, p, diag, &mut rng);
+                if let Some((e, _, _)) = out {
+                    for ch in 0..3 {
+                        escaped[ch] += e[ch];
+                    }
+                }
+                if let Some(entry) = entry_face(bounds, origin, d) {
+                    let exit = out.and_then(|(e, x, dir)| exit_face(bounds, x.clamp(bounds.min, bounds.max), dir).map(|f| (f, e)));
+                    tally.add(entry, ray_power, exit);
                 }
             }
         }
@@ -375,8 +408,17 @@ fn trace_direction(flat: &Scene, caster: &RayCaster, bounds: &Aabb, w: DVec3, co
     (tau, albedo)
 }
 
-/// Follows one path from a first hit; returns its escaping weight per channel.
-fn walk(flat: &Scene, caster: &RayCaster, mut x: DVec3, mut d: DVec3, mut poly: u32, diag: f64, rng: &mut Rng) -> [f64; 3] {
+/// Follows one path from a first hit; returns its escaping weight per channel and the ray it
+/// escapes along (`None` when absorbed).
+fn walk(
+    flat: &Scene,
+    caster: &RayCaster,
+    mut x: DVec3,
+    mut d: DVec3,
+    mut poly: u32,
+    diag: f64,
+    rng: &mut Rng,
+) -> Option<([f64; 3], DVec3, DVec3)> {
     let mut weight = [1.0f64; 3];
     for _ in 0..MAX_BOUNCES {
         let Polygon { poly: geom, material, .. } = &flat.polygons[poly as usize];
@@ -384,7 +426,7 @@ fn walk(flat: &Scene, caster: &RayCaster, mut x: DVec3, mut d: DVec3, mut poly: 
         let n = geom.normal();
         let front = d.dot(n) < 0.0;
         if !front && !m.two_sided {
-            return [0.0; 3];
+            return None;
         }
         let side = if front { n } else { -n };
         let pr = (m.reflectance.iter().sum::<f64>() / 3.0).max(0.0);
@@ -401,19 +443,19 @@ fn walk(flat: &Scene, caster: &RayCaster, mut x: DVec3, mut d: DVec3, mut poly: 
             }
             -side
         } else {
-            return [0.0; 3];
+            return None;
         };
         d = cosine_dir(out_normal, rng);
         x += out_normal * (RAY_OFFSET_REL * diag);
         match caster.closest_hit(x, d) {
-            None => return weight,
+            None => return Some((weight, x, d)),
             Some((t, p)) => {
                 x += d * t;
                 poly = p;
             }
         }
     }
-    [0.0; 3]
+    None
 }
 
 /// Shadow rays per polygon and direction of the radiosity method (a 3 × 3 stratified grid).

@@ -51,6 +51,44 @@ pub struct InstancedConfig {
     /// refined once and reused, solve only, for every later instance of its prototype that lies a
     /// similarity away and whose light is no brighter (see [`solve_instanced`](super::solve_instanced)). 0 disables reuse.
     pub level_cache_bytes: usize,
+    /// How the light a closed instance's proxy sends on leaves it: by the face it entered,
+    /// uniformly (the paper's proxy), or by the faces the prototype's face transfer matrix says
+    /// (see [`ProxyEmission`]).
+    pub proxy_emission: ProxyEmission,
+}
+
+/// How a proxy box re-emits the light it intercepts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ProxyEmission {
+    /// Each face reflects its own irradiance with the prototype's mean escape albedo: the light
+    /// leaves by the face it entered, the same fraction whatever the face (the paper's proxy).
+    Uniform,
+    /// Directional: the power intercepted through face `i` leaves through face `j` in the
+    /// fraction the prototype's face transfer matrix gives
+    /// ([`face_transfer`](crate::instancing::face_transfer)); a twig lit from above also shines
+    /// downward, by what its leaves transmit.
+    #[default]
+    Directional,
+}
+
+impl std::str::FromStr for ProxyEmission {
+    type Err = String;
+    fn from_str(s: &str) -> Result<ProxyEmission, String> {
+        match s {
+            "uniform" => Ok(ProxyEmission::Uniform),
+            "directional" => Ok(ProxyEmission::Directional),
+            _ => Err(format!("`{s}` is not a proxy emission (uniform, directional)")),
+        }
+    }
+}
+
+impl std::fmt::Display for ProxyEmission {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ProxyEmission::Uniform => "uniform",
+            ProxyEmission::Directional => "directional",
+        })
+    }
 }
 
 impl Default for InstancedConfig {
@@ -69,6 +107,7 @@ impl Default for InstancedConfig {
             instance_levels: InstanceLevels::All,
             open_overlap: 1.0,
             direct_samples: 16,
+            proxy_emission: ProxyEmission::default(),
         }
     }
 }

@@ -1,7 +1,8 @@
 //! Level building: a level's local problem (own polygons and proxy faces), refined once for the
 //! light from outside raised to the top of its brightness class, and solved for each instance.
 
-use super::config::{InstancedConfig, local_pipeline};
+use super::config::{InstancedConfig, ProxyEmission, local_pipeline};
+use super::directional::{CrossTerms, polygon_irradiance};
 use super::outside::{OutsideLight, VisibilityTable, outside_irradiance};
 use super::proxy::{MAX_PROXY_REFLECTANCE, Proxy};
 use super::sink::PolygonInfo;
@@ -9,6 +10,7 @@ use super::task::{Closed, OwnPolygon, Task};
 use crate::geom::Poly;
 use crate::hierarchy::Hierarchy;
 use crate::instancing::InstancingError;
+use crate::instancing::face_transfer::BOX_FACES;
 use crate::instancing::flatten::reversed;
 use crate::instancing::model::{InstancedScene, PrototypeId};
 use crate::pipeline;
@@ -51,6 +53,9 @@ pub(super) struct Level {
     pub(super) solution: Option<Solution>,
     /// Iterations of the last solve.
     pub(super) iterations: usize,
+    /// What each proxy face sends out of the light its box's other faces intercept (empty with
+    /// uniform proxies).
+    pub(super) cross: CrossTerms,
 }
 
 impl Level {
@@ -66,6 +71,7 @@ impl Level {
             + self.links.len() * size_of::<Link>()
             + self.table.as_ref().map_or(0, |t| t.counts.len())
             + self.leaf.as_ref().map_or(0, crate::solve::LeafCoefficients::bytes)
+            + self.cross.bytes()
     }
 }
 
@@ -105,22 +111,42 @@ pub(super) fn build_level(
             add(&mut b, &mut roles, &reversed(&poly), material, Role::Own(PolygonInfo { flat_index: k + 1, material, prototype }))?;
         }
     }
-    let mut proxy_material: HashMap<PrototypeId, u32> = HashMap::new();
+    let directional = config.proxy_emission == ProxyEmission::Directional;
+    // Per prototype its proxy materials: one (the mean albedo) for uniform proxies, one per face
+    // (the face transfer matrix's diagonal) for directional ones.
+    let mut proxy_material: HashMap<PrototypeId, [u32; BOX_FACES]> = HashMap::new();
+    let mut face_polys: Vec<Option<[u32; BOX_FACES]>> = Vec::with_capacity(closed.len());
     for (slot, &(c, t, _, _)) in closed.iter().enumerate() {
         let proxy = proxies[&c];
         let m = match proxy_material.get(&c) {
             Some(&m) => m,
             None => {
-                let rho = proxy.albedo.map(|a| a.clamp(0.0, MAX_PROXY_REFLECTANCE));
-                let m = b.material(Material::diffuse(&format!("(proxy {})", scene.prototype(c).name), rho))?;
+                let name = &scene.prototype(c).name;
+                let m = if directional {
+                    let mut m = [0; BOX_FACES];
+                    for (f, m) in m.iter_mut().enumerate() {
+                        let rho = proxy.transfer[f * BOX_FACES + f].map(|a| a.clamp(0.0, MAX_PROXY_REFLECTANCE));
+                        *m = b.material(Material::diffuse(&format!("(proxy {name} face {f})"), rho))?;
+                    }
+                    m
+                } else {
+                    let rho = proxy.albedo.map(|a| a.clamp(0.0, MAX_PROXY_REFLECTANCE));
+                    [b.material(Material::diffuse(&format!("(proxy {name})"), rho))?; BOX_FACES]
+                };
                 let _ = proxy_material.insert(c, m);
                 m
             }
         };
-        for (_, quad) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false) {
+        let mut faces = [0u32; BOX_FACES];
+        let mut one_each = true;
+        for (f, (_, quad)) in box_faces(proxy.shrunk.min, proxy.shrunk.max, false).into_iter().enumerate() {
             let poly = t.poly(&Poly::quad(quad[0], quad[1], quad[2], quad[3]));
-            add(&mut b, &mut roles, &poly, m, Role::ProxyFace { slot })?;
+            let before = roles.len();
+            add(&mut b, &mut roles, &poly, m[f], Role::ProxyFace { slot })?;
+            one_each &= roles.len() == before + 1;
+            faces[f] = before as u32;
         }
+        face_polys.push((directional && one_each).then_some(faces));
     }
     let mut local = b.finish();
     if local.polygons.is_empty() {
@@ -128,6 +154,7 @@ pub(super) fn build_level(
     }
     let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
     let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
+    let cross = CrossTerms::new(&polys, &face_polys, |slot| proxies[&closed[slot].0].transfer);
     let mut table = None;
     if let Some(OutsideLight { dirs, field, split, raise }) = light {
         let caster = crate::visibility::RayCaster::new(&local);
@@ -135,13 +162,17 @@ pub(super) fn build_level(
         let (external, _, _) = outside_irradiance(&polys, &t, dirs, field, split, &roles, &[]);
         table = Some(t);
         let twin = crate::hierarchy::twins(&local);
+        let mut crossed = vec![[0.0; 3]; local.polygons.len()];
+        cross.add_emission(&mut crossed, |i| external.get(i).copied().unwrap_or([0.0; 3]), raise);
         let mut materials = Vec::with_capacity(local.polygons.len());
         for (i, p) in local.polygons.iter_mut().enumerate() {
             let mut m = local.materials[p.material as usize].clone();
             m.name = format!("p{i}");
             let other = external.get(twin[i] as usize).copied().unwrap_or([0.0; 3]);
             let through = if twin[i] == crate::hierarchy::NONE { [0.0; 3] } else { m.transmittance };
-            m.emission = std::array::from_fn(|c| m.emission[c] + raise * (m.reflectance[c] * external[i][c] + through[c] * other[c]));
+            m.emission = std::array::from_fn(|c| {
+                m.emission[c] + raise * (m.reflectance[c] * external[i][c] + through[c] * other[c]) + crossed[i][c]
+            });
             materials.push(m);
             p.material = i as u32;
         }
@@ -170,28 +201,53 @@ pub(super) fn build_level(
         // Lit from outside, the level was refined for raised light: it is solved for its own below.
         solution: light.is_none().then_some(solved.solution),
         iterations: solved.iterations,
+        cross,
     }))
 }
 
 /// The solution of `level` for its instance: the top level's, solved while refining; below it,
 /// the linear system solved with the first reflection of the light from outside (`external`, per
-/// polygon) as the polygons' emission.
+/// polygon) as the polygons' emission. Directional proxies add what their other faces intercept
+/// (see [`super::directional`]): below the top, of the light from outside; at the top, of the
+/// solution's irradiance, the level then solved again.
 pub(super) fn solve_level(level: &mut Level, external: &[[f64; 3]], config: &InstancedConfig) -> Solution {
-    match level.solution.take() {
-        Some(solution) => solution,
+    let solution = match level.solution.take() {
         None => {
-            let h = &mut level.h;
-            for i in 0..h.emission.len() {
-                // The first reflection of the light from outside, and its transmission from
-                // the other side of a transmitting leaf.
-                let ext = external.get(i).copied().unwrap_or([0.0; 3]);
-                let other = external.get(h.twin[i] as usize).copied().unwrap_or([0.0; 3]);
-                h.emission[i] =
-                    std::array::from_fn(|c| level.base_emission[i][c] + h.reflectance[i][c] * ext[c] + h.transmittance[i][c] * other[c]);
-            }
-            let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, &mut level.leaf, &local_pipeline(config));
-            level.iterations = iterations;
-            solution
+            set_emission(level, external, None);
+            return solve_again(level, config);
         }
+        Some(solution) if level.cross.is_empty() => return solution,
+        Some(solution) => solution,
+    };
+    // The top: the light the proxies' other faces intercepted, from the first solve. (Below the
+    // top the light from outside dominates what reaches a proxy; a second solve with the
+    // solution's irradiance changed the age-30 tree's errors by less than 0.01% of the largest
+    // radiosity.)
+    let irradiance: Vec<[f64; 3]> = (0..level.polys.len()).map(|i| polygon_irradiance(level, &solution, i)).collect();
+    set_emission(level, external, Some(&irradiance));
+    solve_again(level, config)
+}
+
+/// Sets the emission of `level`'s hierarchy: the base emission, the first reflection (and a
+/// leaf's transmission) of the light from outside, and the proxies' cross-face emission from
+/// `irradiance` (per polygon, everything arriving) or, without it, from the light from outside.
+fn set_emission(level: &mut Level, external: &[[f64; 3]], irradiance: Option<&[[f64; 3]]>) {
+    let h = &mut level.h;
+    for i in 0..h.emission.len() {
+        // The first reflection of the light from outside, and its transmission from
+        // the other side of a transmitting leaf.
+        let ext = external.get(i).copied().unwrap_or([0.0; 3]);
+        let other = external.get(h.twin[i] as usize).copied().unwrap_or([0.0; 3]);
+        h.emission[i] =
+            std::array::from_fn(|c| level.base_emission[i][c] + h.reflectance[i][c] * ext[c] + h.transmittance[i][c] * other[c]);
     }
+    let source = irradiance.unwrap_or(external);
+    level.cross.add_emission(&mut h.emission, |i| source.get(i).copied().unwrap_or([0.0; 3]), 1.0);
+}
+
+/// Solves the links of `level` for the emission its hierarchy holds.
+fn solve_again(level: &mut Level, config: &InstancedConfig) -> Solution {
+    let (solution, iterations, _) = pipeline::solve_links(&level.h, &level.links, &mut level.leaf, &local_pipeline(config));
+    level.iterations = iterations;
+    solution
 }

@@ -6,6 +6,12 @@
 //!   `√(1 − τ̄)` (so that its projected area is the mean effective area ā = (1 − τ̄)·Ā_box), with the
 //!   prototype's mean escape albedo as reflectance; it blocks, absorbs and reflects like the
 //!   prototype on average over directions and takes no self-link (a box face sees no other face);
+//! - directional proxies ([`ProxyEmission::Directional`], the default): the light a box intercepts
+//!   through one face leaves through each face in the fraction its prototype's face transfer
+//!   matrix gives ([`crate::instancing::face_transfer`], measured with the albedo), not all back
+//!   through the face it entered: a crown lit from above also shines down through its leaves.
+//!   Each face reflects with the matrix's diagonal; what the other faces send out through it is
+//!   its emission (`directional`);
 //! - opening an instance: the links that arrived at its proxy (at a face, below it, or at a cluster
 //!   holding it) are sorted by the direction toward their source into [`LIGHT_DIRECTIONS`] bins, and
 //!   each face's irradiance is split over the bins in those proportions; the flux per bin over the
@@ -54,12 +60,14 @@
 //! properties), `direct` (the traced direct light), `cache` (brightness class, similarity and
 //! the level cache), `level` (building, refining and solving a local problem), `outside` (the
 //! beams from outside and the visibility table), `sink` (streaming the finished polygons),
-//! `handoff` (the light passed on to the closed instances). `config` holds the settings and
+//! `handoff` (the light passed on to the closed instances), `directional` (the proxies' light
+//! sent out through other faces than it entered). `config` holds the settings and
 //! figures, `reference` the full solve and the error measures it is compared by.
 
 mod cache;
 mod config;
 mod direct;
+mod directional;
 mod handoff;
 mod level;
 mod occluders;
@@ -70,7 +78,7 @@ mod sink;
 mod task;
 
 pub use cache::SIMILARITY_TOLERANCE;
-pub use config::{InstanceLevels, InstancedConfig, InstancedStats};
+pub use config::{InstanceLevels, InstancedConfig, InstancedStats, ProxyEmission};
 pub use occluders::MAX_INHERITED_OCCLUDERS;
 pub use outside::{FIELD_REL_MIN, LIGHT_DIRECTIONS, TABLE_DIRECTIONS, TABLE_RAYS};
 pub use proxy::{MAX_PROXY_REFLECTANCE, MIN_PROXY_EXTENT_REL};

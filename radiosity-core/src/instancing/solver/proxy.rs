@@ -4,6 +4,7 @@ use super::config::InstancedStats;
 use super::task::Closed;
 use crate::geom::{Aabb, DVec3};
 use crate::instancing::InstancingError;
+use crate::instancing::face_transfer::BOX_FACES;
 use crate::instancing::model::{InstancedScene, PrototypeId};
 use crate::instancing::properties::{CacheOutcome, PropertyCache, PropertyConfig, RadiativeProperties};
 use std::collections::HashMap;
@@ -22,6 +23,9 @@ pub(super) struct Proxy {
     pub(super) shrunk: Aabb,
     /// Mean escape albedo.
     pub(super) albedo: [f64; 3],
+    /// Face transfer matrix of the prototype's box, row-major (see
+    /// [`face_transfer`](crate::instancing::face_transfer)).
+    pub(super) transfer: [[f64; 3]; BOX_FACES * BOX_FACES],
 }
 
 /// Centre and half-extents of `b` with every extent at least [`MIN_PROXY_EXTENT_REL`] of its
@@ -40,10 +44,13 @@ pub(super) fn padded(b: &Aabb) -> Aabb {
     Aabb { min: c - half, max: c + half }
 }
 
+/// The proxy of a prototype with local box `local` and properties `props`.
 pub(super) fn proxy_of(local: &Aabb, props: &RadiativeProperties) -> Proxy {
     let (c, half) = padded_half(local);
     let s = (1.0 - props.mean_transmittance()).clamp(0.0, 1.0).sqrt().max(MIN_PROXY_EXTENT_REL);
-    Proxy { shrunk: Aabb { min: c - half * s, max: c + half * s }, albedo: props.mean_albedo() }
+    let t = props.face_transfer();
+    let transfer = std::array::from_fn(|k| t.get(k / BOX_FACES, k % BOX_FACES));
+    Proxy { shrunk: Aabb { min: c - half * s, max: c + half * s }, albedo: props.mean_albedo(), transfer }
 }
 
 /// Gets the proxy of every prototype of the `closed` instances that has none yet, from its
