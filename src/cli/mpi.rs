@@ -167,6 +167,15 @@ fn install_watchdog() {
     }
 }
 
+/// Receives the next message from `source`, sleeping between probes: MPI's blocking receive spins,
+/// which takes a core from the solving ranks when ranks share cores (and rank 0 mostly waits).
+fn receive<S: Source>(source: &S) -> (Vec<u8>, mpi::point_to_point::Status) {
+    while source.immediate_probe().is_none() {
+        std::thread::sleep(std::time::Duration::from_micros(500));
+    }
+    source.receive_vec::<u8>()
+}
+
 /// Describes subtree `i` of `n`.
 fn describe(scene: &InstancedScene, i: usize, n: usize, s: &Subtree) -> String {
     format!(
@@ -223,7 +232,7 @@ fn coordinate(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn R
         }
     };
     while stopped < size - 1 {
-        let (msg, status) = world.any_process().receive_vec::<u8>();
+        let (msg, status) = receive(&world.any_process());
         let r = status.source_rank();
         report.bytes_from_workers += msg.len() as u64;
         report.largest_message_bytes = report.largest_message_bytes.max(msg.len() as u64);
@@ -320,7 +329,7 @@ pub fn work(scene: &InstancedScene, config: &InstancedConfig) -> anyhow::Result<
         let mut received = 0u64;
         let mut work_tx = Some(work_tx);
         let looped: Result<(), String> = 'outer: loop {
-            let (msg, status) = root.receive_vec::<u8>();
+            let (msg, status) = receive(&root);
             match status.tag() {
                 TAG_WORK => {
                     received += 1;
@@ -373,7 +382,7 @@ pub fn work(scene: &InstancedScene, config: &InstancedConfig) -> anyhow::Result<
         Err(e) => {
             // Rank 0 names the subtree and ends the job; wait for that.
             root.send_with_tag(e.as_bytes(), TAG_ERROR);
-            let _ = root.receive_vec::<u8>();
+            let _ = receive(&root);
             anyhow::bail!("rank {me}: {e}")
         }
     }
