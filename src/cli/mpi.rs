@@ -95,6 +95,8 @@ pub struct Report {
     subtree_seconds_sum: f64,
     subtree_seconds_max: f64,
     largest_message_bytes: u64,
+    write_seconds: f64,
+    polygons_written: u64,
     peak_rss_bytes_per_rank: Vec<u64>,
 }
 
@@ -110,6 +112,8 @@ impl Report {
             "subtree_seconds_sum": self.subtree_seconds_sum,
             "subtree_seconds_max": self.subtree_seconds_max,
             "largest_message_bytes": self.largest_message_bytes,
+            "write_seconds": self.write_seconds,
+            "polygons_written": self.polygons_written,
             "peak_rss_bytes_per_rank": self.peak_rss_bytes_per_rank,
         })
     }
@@ -176,6 +180,15 @@ fn receive<S: Source>(source: &S) -> (Vec<u8>, mpi::point_to_point::Status) {
     source.receive_vec::<u8>()
 }
 
+/// Writes encoded polygons to `sink`, timing it (rank 0's output stream, the part of a distributed
+/// run that does not shrink with more ranks).
+fn write(bytes: &[u8], sink: &mut dyn RadiositySink, report: &mut Report) -> anyhow::Result<()> {
+    let t = Instant::now();
+    report.polygons_written += distributed::replay(bytes, sink)?;
+    report.write_seconds += t.elapsed().as_secs_f64();
+    Ok(())
+}
+
 /// Describes subtree `i` of `n`.
 fn describe(scene: &InstancedScene, i: usize, n: usize, s: &Subtree) -> String {
     format!(
@@ -215,6 +228,8 @@ fn coordinate(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn R
         subtree_seconds_sum: 0.0,
         subtree_seconds_max: 0.0,
         largest_message_bytes: 0,
+        write_seconds: 0.0,
+        polygons_written: 0,
         peak_rss_bytes_per_rank: vec![0; size as usize],
     };
     let update_in_flight = |held: &[Option<usize>]| {
@@ -247,11 +262,11 @@ fn coordinate(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn R
                     // Write every finished subtree that is next in order, then what the next one
                     // (still being solved) has sent so far; its further chunks are written as they come.
                     while next_write < n && done[next_write] {
-                        let _ = distributed::replay(&std::mem::take(&mut pending[next_write]), sink)?;
+                        write(&std::mem::take(&mut pending[next_write]), sink, &mut report)?;
                         next_write += 1;
                     }
                     if next_write < n && !pending[next_write].is_empty() {
-                        let _ = distributed::replay(&std::mem::take(&mut pending[next_write]), sink)?;
+                        write(&std::mem::take(&mut pending[next_write]), sink, &mut report)?;
                     }
                 }
                 held[r as usize] = None;
@@ -272,7 +287,7 @@ fn coordinate(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn R
                 let Some(i) = holding else { anyhow::bail!("rank {r} sent polygons while holding no subtree") };
                 result_bytes[i] += msg.len() as u64;
                 if i == next_write {
-                    let _ = distributed::replay(&msg, sink).with_context(|| format!("from rank {r}"))?;
+                    write(&msg, sink, &mut report).with_context(|| format!("from rank {r}"))?;
                 } else {
                     pending[i].extend_from_slice(&msg);
                 }
