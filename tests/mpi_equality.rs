@@ -1,6 +1,7 @@
 //! The instanced solve over MPI ranks (feature `mpi`) writes the files one process writes, byte for
 //! byte: a small generated forest solved by one process (`--level-reuse subtree`, no mpirun), by
-//! `mpirun -n 1` and by `mpirun --oversubscribe -n 2` (rank 0 solves the top level, rank 1 every
+//! `mpirun -n 1` (reading the prototype properties the first run cached) and by
+//! `mpirun --oversubscribe -n 2` (rank 0 solves the top level, rank 1 every
 //! subtree), the files compared; stats.json compared but for the keys that legitimately differ.
 //! And a rank that dies mid-job ends the job with an error, not a hang.
 //!
@@ -77,6 +78,13 @@ fn two_ranks_write_the_files_of_one_process_and_a_dead_rank_ends_the_job() {
     ok(&run(BIN, &["generate", "forest", "--trees", "2", "--min-age", "3", "--max-age", "4", "--out", "forest"], &[], d), "generate");
     // The feature build without mpirun is one process.
     ok(&run(BIN, &solve_args("one")[1..], &[], d), "one process");
+    // `mpirun -n 1` starts with the property cache one process wrote: properties read back must be
+    // the bits computed (ranks read what other ranks cached).
+    std::fs::create_dir_all(d.join("n1/prototype-cache")).unwrap();
+    for entry in std::fs::read_dir(d.join("one/prototype-cache")).unwrap() {
+        let entry = entry.unwrap();
+        let _ = std::fs::copy(entry.path(), d.join("n1/prototype-cache").join(entry.file_name())).unwrap();
+    }
     let mut n1 = vec!["--oversubscribe", "-n", "1"];
     n1.extend(solve_args("n1"));
     ok(&run("mpirun", &n1, &[], d), "mpirun -n 1");
@@ -95,6 +103,9 @@ fn two_ranks_write_the_files_of_one_process_and_a_dead_rank_ends_the_job() {
             assert!(a == b, "{run}/{name} differs from one process's ({} and {} bytes)", a.len(), b.len());
         }
         let mut s = stats(d, run);
+        if run == "n1" {
+            assert_eq!(s["cache_computed"], 0, "n1 reads every property from the cache");
+        }
         if run == "n2" {
             let mpi = &s["mpi"];
             assert_eq!(mpi["ranks"], 2, "{mpi}");

@@ -39,6 +39,11 @@ const TAG_STATS: i32 = 6;
 /// The worker failed (a UTF-8 message).
 const TAG_ERROR: i32 = 7;
 
+/// Subtrees handed out at most this many times the workers ahead of the next one to write: bounds
+/// what rank 0 holds of subtrees that finished ahead of an earlier one (when rank 0's writing is
+/// the bottleneck, workers then wait instead of rank 0's memory growing).
+const WINDOW_PER_WORKER: usize = 4;
+
 /// Set once MPI is initialised with more than one rank.
 static DISTRIBUTED: AtomicBool = AtomicBool::new(false);
 
@@ -219,6 +224,8 @@ fn coordinate(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn R
     let mut result_bytes = vec![0u64; n];
     let mut ranks = vec![0i32; n];
     let (mut next_hand, mut next_write, mut stopped) = (0usize, 0usize, 0);
+    let mut idle: Vec<i32> = Vec::new();
+    let window = WINDOW_PER_WORKER * (size as usize - 1);
     let mut report = Report {
         ranks: size,
         subtrees: n,
@@ -270,16 +277,24 @@ fn coordinate(scene: &InstancedScene, config: &InstancedConfig, sink: &mut dyn R
                     }
                 }
                 held[r as usize] = None;
-                if next_hand < n {
-                    let s = &subtrees[next_hand];
-                    world.process_at_rank(r).send_with_tag(&s.bytes[..], TAG_WORK);
-                    report.bytes_to_workers += s.bytes.len() as u64;
-                    report.largest_message_bytes = report.largest_message_bytes.max(s.bytes.len() as u64);
-                    held[r as usize] = Some(next_hand);
-                    ranks[next_hand] = r;
-                    next_hand += 1;
-                } else {
-                    world.process_at_rank(r).send_with_tag(&[0u8; 0][..], TAG_STOP);
+                idle.push(r);
+                // Hand out subtrees in order to the idle ranks, at most `window` ahead of the
+                // next one to write: what finishes ahead of it waits in memory here.
+                while let Some(&r) = idle.last() {
+                    if next_hand < n && next_hand < next_write + window {
+                        let s = &subtrees[next_hand];
+                        world.process_at_rank(r).send_with_tag(&s.bytes[..], TAG_WORK);
+                        report.bytes_to_workers += s.bytes.len() as u64;
+                        report.largest_message_bytes = report.largest_message_bytes.max(s.bytes.len() as u64);
+                        held[r as usize] = Some(next_hand);
+                        ranks[next_hand] = r;
+                        next_hand += 1;
+                    } else if next_hand >= n {
+                        world.process_at_rank(r).send_with_tag(&[0u8; 0][..], TAG_STOP);
+                    } else {
+                        break;
+                    }
+                    let _ = idle.pop();
                 }
                 update_in_flight(&held);
             }
