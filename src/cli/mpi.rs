@@ -2,7 +2,8 @@
 //!
 //! `mpirun -n K radiosity solve scene.toml ...` with K ≥ 2: rank 0 solves the top level and keeps
 //! its closed instances' subtrees in a queue, in the order one process solves them; every other
-//! rank asks for a subtree when it is idle, solves it (keeping prototype properties, and levels
+//! rank asks for a subtree when it is idle (handed out in order, at most [`WINDOW_PER_WORKER`] per
+//! worker ahead of the next one to write), solves it (keeping prototype properties, and levels
 //! within the subtree, as one process does) and streams its finished polygons back in chunks;
 //! rank 0 writes them in the queue's order, so its output files are those of one process run with
 //! `--level-reuse subtree` (which a distributed run always uses). A process started without
