@@ -490,4 +490,61 @@ mod tests {
         assert_eq!((total.local_solves, total.max_local_polygons, total.levels_cached_peak_bytes), (4, 20, 5));
         assert!(decode_stats(&[0; 95]).is_err());
     }
+
+    /// The distributed machinery without MPI: the top level, then its subtrees on two worker
+    /// threads in other orders than one process takes them (one worker takes the even ones
+    /// backwards, the other the odd ones), the polygons replayed in order: the bits of one process
+    /// solving with [`LevelReuse::Subtree`], and the same figures.
+    #[test]
+    fn subtrees_solved_on_threads_in_any_order_give_the_bits_of_one_process() {
+        use crate::instancing::{ForestParams, generate_forest, solve_instanced};
+        use std::sync::mpsc::channel;
+        let scene = generate_forest(&ForestParams { trees: 2, min_age: 3, max_age: 4, ..ForestParams::default() });
+        let config = InstancedConfig { level_reuse: LevelReuse::Subtree, ..InstancedConfig::default() };
+        let mut one = Bits::default();
+        let one_stats = solve_instanced(&scene, &config, &mut one).unwrap();
+
+        let mut many = Bits::default();
+        let top = solve_top_level(&scene, &config, &mut many).unwrap();
+        let n = top.subtrees.len();
+        assert!(n > 2, "{n} subtrees");
+        let orders: [Vec<usize>; 2] = [(0..n).step_by(2).rev().collect(), (1..n).step_by(2).collect()];
+        let mut results: Vec<Vec<u8>> = vec![Vec::new(); n];
+        let mut stats = top.stats;
+        std::thread::scope(|s| {
+            let workers: Vec<_> = orders
+                .iter()
+                .map(|order| {
+                    let (work, work_rx) = channel();
+                    let (events_tx, events) = channel();
+                    for &i in order {
+                        work.send(top.subtrees[i].bytes.clone()).unwrap();
+                    }
+                    drop(work);
+                    let (scene, config) = (&scene, &config);
+                    (order, events, s.spawn(move || solve_subtrees(scene, config, work_rx, events_tx)))
+                })
+                .collect();
+            for (order, events, handle) in workers {
+                merge_stats(&mut stats, &handle.join().unwrap().unwrap());
+                let mut next = order.iter();
+                let mut current = *next.next().unwrap();
+                for event in events.try_iter() {
+                    match event {
+                        WorkerEvent::Polygons(bytes) => results[current].extend_from_slice(&bytes),
+                        WorkerEvent::Finished(_) => current = next.next().copied().unwrap_or(usize::MAX),
+                    }
+                }
+                assert_eq!(current, usize::MAX, "every subtree finished");
+            }
+        });
+        for bytes in &results {
+            let _ = replay(bytes, &mut many).unwrap();
+        }
+        assert_eq!(one.0.len(), many.0.len());
+        assert!(one.0 == many.0, "the distributed solve's bits differ from one process's");
+        let counts = |s: &InstancedStats| (s.local_solves, s.levels_reused, s.links, s.polygons_out, s.leaves_out, s.max_local_links);
+        assert_eq!(counts(&stats), counts(&one_stats));
+        assert!(one_stats.levels_reused > 0, "levels are reused within subtrees");
+    }
 }
