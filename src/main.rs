@@ -6,6 +6,9 @@ mod cli;
 use clap::Parser;
 
 fn main() -> std::process::ExitCode {
+    // Under mpirun (feature `mpi`): MPI is initialised here and finalised when this is dropped.
+    #[cfg(feature = "mpi")]
+    let _universe = cli::mpi::init();
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(()) => std::process::ExitCode::SUCCESS,
@@ -13,6 +16,9 @@ fn main() -> std::process::ExitCode {
             // One line: the chain of causes joined, the outermost first.
             let msg: Vec<String> = e.chain().map(ToString::to_string).collect();
             eprintln!("error: {}", msg.join(": "));
+            // A distributed run ends every rank (the others would wait for this one).
+            #[cfg(feature = "mpi")]
+            cli::mpi::abort_if_distributed();
             std::process::ExitCode::FAILURE
         }
     }

@@ -4,6 +4,8 @@ mod bench;
 mod bench_accuracy;
 mod bench_reference;
 mod generate;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 mod oracle;
 mod picture;
 mod progress;
@@ -51,6 +53,10 @@ enum Command {
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    #[cfg(feature = "mpi")]
+    if !matches!(cli.command, Command::Solve(_)) {
+        mpi::refuse_plain()?;
+    }
     match cli.command {
         Command::Solve(args) => solve::run(&args),
         Command::Sweep(args) => sweep::run(&args),

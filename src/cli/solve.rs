@@ -44,6 +44,11 @@ pub struct SolveArgs {
     /// the same prototype (0: refine every instance anew; slower, a little less memory).
     #[arg(long, default_value_t = 16.0, value_name = "MB")]
     pub level_cache_mb: f64,
+    /// Instanced scenes: `scene` reuses a refined level for later instances anywhere in the scene;
+    /// `subtree` only within one top-level instance's subtree, so that results depend on the
+    /// subtree alone: what a run over MPI ranks does (feature `mpi`), byte for byte.
+    #[arg(long, default_value = "scene", value_name = "SCOPE")]
+    pub level_reuse: radiosity::instancing::LevelReuse,
     /// Instanced scenes: which nesting depths keep their instances closed: `all`, `every-N`
     /// (depths N, 2N, ...; the others are opened in place), or `none` (one flattened problem).
     #[arg(long, default_value = "all", value_name = "POLICY")]
@@ -174,6 +179,8 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             return solve_instanced(args, &scene, None);
         }
     }
+    #[cfg(feature = "mpi")]
+    super::mpi::refuse_plain()?;
     if args.instances == Instances::Auto {
         refuse_plain_only(args)?;
         let scene = load_scene(args.scene.as_ref(), args.options.common.allow_dark)?;
@@ -479,7 +486,7 @@ fn solve_instanced(
     scene: &radiosity::instancing::InstancedScene,
     auto: Option<&radiosity::instancing::AutoReport>,
 ) -> anyhow::Result<()> {
-    use radiosity::instancing::{self, InstancedConfig, StreamedOutput};
+    use radiosity::instancing::{InstancedConfig, StreamedOutput};
     let t0 = Instant::now();
     let name = args.scene.as_ref().map_or_else(|| scene.name.clone(), |p| p.display().to_string());
     let trace = std::env::var_os("RADIOSITY_TRACE").is_some();
@@ -491,9 +498,22 @@ fn solve_instanced(
     config.instance_levels = args.instance_levels;
     config.direct_samples = args.direct_samples;
     config.proxy_emission = args.proxy_emission;
+    config.level_reuse = args.level_reuse;
+    // Over MPI ranks (feature `mpi`), levels are reused within a subtree; ranks other than 0 solve
+    // subtrees and write nothing.
+    #[cfg(feature = "mpi")]
+    if super::mpi::distributed() {
+        config.level_reuse = radiosity::instancing::LevelReuse::Subtree;
+        if super::mpi::rank() != 0 {
+            return super::mpi::work(scene, &config);
+        }
+    }
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
-    let stats = instancing::solve_instanced(scene, &config, &mut sink)?;
+    #[cfg(feature = "mpi")]
+    let (stats, mpi_report) = super::mpi::solve(scene, &config, &mut sink)?;
+    #[cfg(not(feature = "mpi"))]
+    let stats = radiosity::instancing::solve_instanced(scene, &config, &mut sink)?;
     sink.reporter.finish();
     let sink = sink.inner;
     let t_out = Instant::now();
@@ -510,6 +530,13 @@ fn solve_instanced(
     doc["time_s"] =
         serde_json::json!({ "solve": stats.seconds, "output": t_out.elapsed().as_secs_f64(), "total": t0.elapsed().as_secs_f64() });
     doc["peak_rss_bytes"] = serde_json::json!(output::peak_rss_bytes());
+    if config.level_reuse == radiosity::instancing::LevelReuse::Subtree {
+        doc["level_reuse"] = serde_json::json!("subtree");
+    }
+    #[cfg(feature = "mpi")]
+    if let Some(report) = mpi_report {
+        doc["mpi"] = report.to_json();
+    }
     let stats_path = args.out.join("stats.json");
     output::atomic::write_bytes(&stats_path, serde_json::to_string_pretty(&doc)? + "\n")
         .with_context(|| format!("{}: cannot write", stats_path.display()))?;

@@ -51,6 +51,10 @@ pub enum InstancingError {
         /// Decoder message.
         msg: String,
     },
+    /// A distributed solve failed: a message between processes that cannot be decoded, or a
+    /// process that failed (the message names it).
+    #[error("distributed solve: {0}")]
+    Distributed(String),
 }
 
 impl From<SceneError> for InstancingError {

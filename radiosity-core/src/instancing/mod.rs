@@ -84,7 +84,7 @@ pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, 
 pub use output::{StreamedOutput, StreamedSummary};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};
 pub use solver::{
-    InstanceLevels, InstancedConfig, InstancedStats, Leaf, PolygonInfo, PolygonMeans, ProxyEmission, RadiositySink, solve_full,
+    InstanceLevels, InstancedConfig, InstancedStats, Leaf, LevelReuse, PolygonInfo, PolygonMeans, ProxyEmission, RadiositySink, distributed, solve_full,
     solve_instanced,
 };
 pub use write::write_scene;

@@ -132,6 +132,12 @@ impl LevelCache {
         &mut self.entries.get_mut(key).expect("found before").level
     }
 
+    /// Drops every cached level (the peak stays).
+    pub(super) fn clear(&mut self) {
+        self.entries.clear();
+        self.bytes = 0;
+    }
+
     /// Keeps `level` (replacing the entry of `key`) if it fits the budget, evicting the least
     /// recently used levels as needed.
     pub(super) fn insert(&mut self, key: LevelKey, level: Level, frame: DMat4) {

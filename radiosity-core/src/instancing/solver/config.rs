@@ -51,6 +51,9 @@ pub struct InstancedConfig {
     /// refined once and reused, solve only, for every later instance of its prototype that lies a
     /// similarity away and whose light is no brighter (see [`solve_instanced`](super::solve_instanced)). 0 disables reuse.
     pub level_cache_bytes: usize,
+    /// Whether a level refined under one top-level instance may be reused under another (see
+    /// [`LevelReuse`]).
+    pub level_reuse: LevelReuse,
     /// How the light a closed instance's proxy sends on leaves it: by the face it entered,
     /// uniformly (the paper's proxy), or by the faces the prototype's face transfer matrix says
     /// (see [`ProxyEmission`]).
@@ -108,6 +111,33 @@ impl Default for InstancedConfig {
             open_overlap: 1.0,
             direct_samples: 16,
             proxy_emission: ProxyEmission::default(),
+            level_reuse: LevelReuse::Scene,
+        }
+    }
+}
+
+/// How far the level cache reaches. A reused level is the level refined for the light of the
+/// instance that first built it (raised to its brightness class), in that instance's frame: the
+/// results of an instance depend on which instances were solved before it. A distributed solve
+/// (see [`distributed`](super::distributed)) hands each top-level instance's subtree to whichever
+/// process is free, so it keeps reuse within a subtree, which one process reproduces exactly.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LevelReuse {
+    /// Levels are reused across the whole scene (one process; the default).
+    #[default]
+    Scene,
+    /// The level cache is emptied before each top-level instance's subtree: results depend on the
+    /// subtree alone, so one process and any number of MPI ranks give the same bytes.
+    Subtree,
+}
+
+impl std::str::FromStr for LevelReuse {
+    type Err = String;
+    fn from_str(s: &str) -> Result<LevelReuse, String> {
+        match s {
+            "scene" => Ok(LevelReuse::Scene),
+            "subtree" => Ok(LevelReuse::Subtree),
+            _ => Err(format!("`{s}` is not a level reuse scope (scene, subtree)")),
         }
     }
 }

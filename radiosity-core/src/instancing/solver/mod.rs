@@ -68,6 +68,7 @@ mod cache;
 mod config;
 mod direct;
 mod directional;
+pub mod distributed;
 mod handoff;
 mod level;
 mod occluders;
@@ -78,7 +79,7 @@ mod sink;
 mod task;
 
 pub use cache::SIMILARITY_TOLERANCE;
-pub use config::{InstanceLevels, InstancedConfig, InstancedStats, ProxyEmission};
+pub use config::{InstanceLevels, InstancedConfig, InstancedStats, LevelReuse, ProxyEmission};
 pub use occluders::MAX_INHERITED_OCCLUDERS;
 pub use outside::{FIELD_REL_MIN, LIGHT_DIRECTIONS, TABLE_DIRECTIONS, TABLE_RAYS};
 pub use proxy::{MAX_PROXY_REFLECTANCE, MIN_PROXY_EXTENT_REL};
@@ -91,6 +92,7 @@ use crate::instancing::model::{InstancedScene, PrototypeId, Transform};
 use crate::instancing::properties::{PropertyCache, content_hashes};
 use cache::{LevelCache, light_class};
 use direct::{build_caster, direct_split, top_emitters};
+use distributed::{Alone, Driver};
 use handoff::{child_fields, push_children};
 use level::{Level, build_level, solve_level};
 use occluders::{Occluders, child_occluders};
@@ -110,18 +112,15 @@ pub fn solve_instanced(
     // Run on a worker of the thread pool: the many small parallel loops of the local problems then
     // start on this thread and are shared by work stealing, instead of each being handed to the
     // pool and waited for (a futex round trip per loop, which dominated small levels).
-    rayon::scope(|_| solve_depth_first(scene, config, sink))
+    rayon::scope(|_| solve_depth_first(scene, config, &mut Alone::new(sink, config.level_reuse)))
 }
 
 /// The depth-first solve: per task (an instance to open, the scene first), gather its level, get
 /// the closed instances' proxies, split off the direct light, find or build the level, take the
 /// light from outside into it, solve, stream its own polygons, and hand the light that reached
-/// each proxy on to the instance as a new task.
-fn solve_depth_first(
-    scene: &InstancedScene,
-    config: &InstancedConfig,
-    sink: &mut dyn RadiositySink,
-) -> Result<InstancedStats, InstancingError> {
+/// each proxy on to the instance as a new task. The `driver` holds the sink, and may take the top
+/// level's instances once it is solved and hand them back one at a time (see [`distributed`]).
+fn solve_depth_first(scene: &InstancedScene, config: &InstancedConfig, driver: &mut dyn Driver) -> Result<InstancedStats, InstancingError> {
     let t0 = std::time::Instant::now();
     scene.validate()?;
     let counts = scene.flattened_counts(true);
@@ -139,6 +138,9 @@ fn solve_depth_first(
         direct: Vec::new(),
         occluders: Occluders::default(),
     }];
+    if !driver.starts_at_top() {
+        stack.clear();
+    }
     // Direct light: the top level's emitters (scene frame) and the caster that sees every
     // instance's own geometry, built after the top level (the largest local problem) is freed.
     let tracing = config.direct_samples > 0;
@@ -152,7 +154,22 @@ fn solve_depth_first(
     let min_area = config.pipeline.build.min_area_rel * scene.flattened_areas(true)[scene.root as usize];
     let dirs = light_directions();
     let mut levels = LevelCache::new(config.level_cache_bytes);
-    while let Some(task) = stack.pop() {
+    loop {
+        // When the stack runs empty, the driver may hand out the next top-level instance (with
+        // `LevelReuse::Subtree`, each starts with an empty level cache).
+        let task = match stack.pop() {
+            Some(task) => task,
+            None => match driver.next(&mut direct_emitters)? {
+                Some(task) => {
+                    if config.level_reuse == LevelReuse::Subtree {
+                        levels.clear();
+                    }
+                    task
+                }
+                None => break,
+            },
+        };
+        let at_top = task.incoming.is_none();
         let Gathered { own, closed, inlined } = gather_level(scene, config, &counts, &bounds, &task);
         if task.incoming.is_none() && tracing {
             direct_emitters = top_emitters(scene, &own);
@@ -198,7 +215,8 @@ fn solve_depth_first(
             trace_solve(&stats, &scene.prototype(task.prototype).name, level, closed.len(), similarity.is_some(), t_local);
         }
         count_solve(&mut stats, level, similarity.is_some());
-        let face_irradiance = stream_own(level, &solution, &light.external, similarity.as_ref(), task.flat_base, sink, &mut stats)?;
+        let face_irradiance =
+            stream_own(level, &solution, &light.external, similarity.as_ref(), task.flat_base, driver.sink(), &mut stats)?;
         let handoff = child_fields(level, &solution, &light, &face_irradiance, closed.len(), tracing && task.incoming.is_none());
         drop(solution);
         if let Some(level) = fresh
@@ -207,6 +225,9 @@ fn solve_depth_first(
             levels.insert(key, level, task.transform.matrix);
         }
         push_children(&mut stack, &closed, handoff, child_occluders);
+        if at_top {
+            driver.top_level_done(&mut stack, &direct_emitters)?;
+        }
     }
     stats.levels_cached_peak_bytes = levels.peak_bytes as u64;
     stats.seconds = t0.elapsed().as_secs_f64();

@@ -15,6 +15,15 @@ pub(super) struct Occluders {
 }
 
 impl Occluders {
+    /// Occluders holding `polys` alone, in order (a task received from another process).
+    pub(super) fn from_polys(polys: Vec<Poly>) -> Occluders {
+        if polys.is_empty() {
+            return Occluders::default();
+        }
+        let index = (0..polys.len() as u32).collect();
+        Occluders { pool: Some(polys.into()), index }
+    }
+
     pub(super) fn iter(&self) -> impl Iterator<Item = &Poly> {
         self.pool.iter().flat_map(|pool| self.index.iter().map(move |&i| &pool[i as usize]))
     }
