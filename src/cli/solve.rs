@@ -162,7 +162,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             lit_scene = Some(plain);
         } else {
             refuse_plain_only(args)?;
-            return solve_instanced(args, &scene, None);
+            return solve_instanced(args, &scene, None, lighting.bands.pack_distant(0));
         }
     }
     if args.instances == Instances::Auto {
@@ -176,7 +176,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             }
             println!("{} in {:.3}s", auto.report, t0.elapsed().as_secs_f64());
         }
-        return solve_instanced(args, &auto.scene, Some(&auto.report));
+        return solve_instanced(args, &auto.scene, Some(&auto.report), Vec::new());
     }
     let t0 = Instant::now();
     let reporter = Reporter::new(args.quiet);
@@ -404,10 +404,12 @@ fn write_grids(
 /// report goes to `stats.json`): solved depth-first, one instance open at a time, finished polygons
 /// streamed to `patches.csv` and a spool from which `solution.ply`, `solution.glb` and `image.png` are written at
 /// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
+/// `daylight`: the scene file's sun and sky.
 fn solve_instanced(
     args: &SolveArgs,
     scene: &radiosity::instancing::InstancedScene,
     auto: Option<&radiosity::instancing::AutoReport>,
+    daylight: Vec<radiosity::daylight::DistantSource>,
 ) -> anyhow::Result<()> {
     use radiosity::instancing::{self, InstancedConfig, StreamedOutput};
     let t0 = Instant::now();
@@ -420,6 +422,7 @@ fn solve_instanced(
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     config.instance_levels = args.instance_levels;
     config.direct_samples = args.direct_samples;
+    config.daylight = daylight;
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
     let stats = instancing::solve_instanced(scene, &config, &mut sink)?;

@@ -51,6 +51,8 @@ pub(super) struct Level {
     pub(super) solution: Option<Solution>,
     /// Iterations of the last solve.
     pub(super) iterations: usize,
+    /// The top level's daylight (see [`super::daylight`]), taken by the solve of the top.
+    pub(super) daylight: Option<super::outside::LevelLight>,
 }
 
 impl Level {
@@ -81,6 +83,7 @@ pub(super) fn build_level(
     closed: &[Closed],
     proxies: &HashMap<PrototypeId, Proxy>,
     light: Option<OutsideLight<'_>>,
+    top_daylight: Option<&super::daylight::TopDaylight<'_>>,
     (b_ref_scene, min_area): (f64, f64),
     config: &InstancedConfig,
 ) -> Result<Option<Level>, InstancingError> {
@@ -128,6 +131,8 @@ pub(super) fn build_level(
     }
     let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
     let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
+    // At the top, the daylight's first reflection becomes the polygons' emission.
+    let daylight = if light.is_none() { top_daylight.map(|d| d.light(&mut local, &roles)) } else { None };
     let mut table = None;
     if let Some(OutsideLight { dirs, field, split, raise }) = light {
         let caster = crate::visibility::RayCaster::new(&local);
@@ -170,6 +175,7 @@ pub(super) fn build_level(
         // Lit from outside, the level was refined for raised light: it is solved for its own below.
         solution: light.is_none().then_some(solved.solution),
         iterations: solved.iterations,
+        daylight,
     }))
 }
 
