@@ -176,7 +176,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             lit_scene = Some(plain);
         } else {
             refuse_plain_only(args)?;
-            return solve_instanced(args, &scene, None);
+            return solve_instanced(args, &scene, None, lighting.bands.pack_distant(0));
         }
     }
     #[cfg(feature = "mpi")]
@@ -192,7 +192,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             }
             println!("{} in {:.3}s", auto.report, t0.elapsed().as_secs_f64());
         }
-        return solve_instanced(args, &auto.scene, Some(&auto.report));
+        return solve_instanced(args, &auto.scene, Some(&auto.report), Vec::new());
     }
     let t0 = Instant::now();
     let reporter = Reporter::new(args.quiet);
@@ -481,10 +481,12 @@ fn write_grids(
 /// report goes to `stats.json`): solved depth-first, one instance open at a time, finished polygons
 /// streamed to `patches.csv` and a spool from which `solution.ply`, `solution.glb` and `image.png` are written at
 /// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
+/// `daylight`: the scene file's sun and sky.
 fn solve_instanced(
     args: &SolveArgs,
     scene: &radiosity::instancing::InstancedScene,
     auto: Option<&radiosity::instancing::AutoReport>,
+    daylight: Vec<radiosity::daylight::DistantSource>,
 ) -> anyhow::Result<()> {
     use radiosity::instancing::{InstancedConfig, StreamedOutput};
     let t0 = Instant::now();
@@ -497,6 +499,7 @@ fn solve_instanced(
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     config.instance_levels = args.instance_levels;
     config.direct_samples = args.direct_samples;
+    config.daylight = daylight;
     config.proxy_emission = args.proxy_emission;
     config.level_reuse = args.level_reuse;
     // Over MPI ranks (feature `mpi`), levels are reused within a subtree; ranks other than 0 solve

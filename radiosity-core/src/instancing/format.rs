@@ -175,14 +175,11 @@ pub struct Lighting {
 
 impl Lighting {
     /// Whether the file asks for anything the instanced solver does not do (luminaires, photometric
-    /// units, daylight, more than three bands): such a scene is flattened and solved as a plain
-    /// scene.
+    /// units, more than three bands): such a scene is flattened and solved as a plain scene. The
+    /// sun and the sky it does ([`InstancedConfig::daylight`](super::InstancedConfig::daylight)).
     #[must_use]
     pub fn needs_plain_solve(&self) -> bool {
-        !self.luminaires.is_empty()
-            || self.units != crate::photometry::Units::Radiometric
-            || self.bands.has_daylight()
-            || self.bands.packs() > 1
+        !self.luminaires.is_empty() || self.units != crate::photometry::Units::Radiometric || self.bands.packs() > 1
     }
 }
 

@@ -51,6 +51,11 @@ pub struct InstancedConfig {
     /// refined once and reused, solve only, for every later instance of its prototype that lies a
     /// similarity away and whose light is no brighter (see [`solve_instanced`](super::solve_instanced)). 0 disables reuse.
     pub level_cache_bytes: usize,
+    /// The scene's distant sources (the sun and the sky's cells, in the scene's frame; see
+    /// [`crate::daylight`]): they light every own polygon through the whole instanced structure
+    /// and the top level's proxies as beams (see the `daylight` step of
+    /// [`solve_instanced`](super::solve_instanced)). Empty: no daylight.
+    pub daylight: Vec<crate::daylight::DistantSource>,
     /// Whether a level refined under one top-level instance may be reused under another (see
     /// [`LevelReuse`]).
     pub level_reuse: LevelReuse,
@@ -110,6 +115,7 @@ impl Default for InstancedConfig {
             instance_levels: InstanceLevels::All,
             open_overlap: 1.0,
             direct_samples: 16,
+            daylight: Vec::new(),
             proxy_emission: ProxyEmission::default(),
             level_reuse: LevelReuse::Scene,
         }

@@ -56,6 +56,8 @@ pub(super) struct Level {
     /// What each proxy face sends out of the light its box's other faces intercept (empty with
     /// uniform proxies).
     pub(super) cross: CrossTerms,
+    /// The top level's daylight (see [`super::daylight`]), taken by the solve of the top.
+    pub(super) daylight: Option<super::outside::LevelLight>,
 }
 
 impl Level {
@@ -87,6 +89,7 @@ pub(super) fn build_level(
     closed: &[Closed],
     proxies: &HashMap<PrototypeId, Proxy>,
     light: Option<OutsideLight<'_>>,
+    top_daylight: Option<&super::daylight::TopDaylight<'_>>,
     (b_ref_scene, min_area): (f64, f64),
     config: &InstancedConfig,
 ) -> Result<Option<Level>, InstancingError> {
@@ -155,6 +158,8 @@ pub(super) fn build_level(
     let base_emission: Vec<[f64; 3]> = local.polygons.iter().map(|p| local.materials[p.material as usize].emission).collect();
     let polys: Vec<Poly> = local.polygons.iter().map(|p| p.poly).collect();
     let cross = CrossTerms::new(&polys, &face_polys, |slot| proxies[&closed[slot].0].transfer);
+    // At the top, the daylight's first reflection becomes the polygons' emission.
+    let daylight = if light.is_none() { top_daylight.map(|d| d.light(&mut local, &roles)) } else { None };
     let mut table = None;
     if let Some(OutsideLight { dirs, field, split, raise }) = light {
         let caster = crate::visibility::RayCaster::new(&local);
@@ -202,6 +207,7 @@ pub(super) fn build_level(
         solution: light.is_none().then_some(solved.solution),
         iterations: solved.iterations,
         cross,
+        daylight,
     }))
 }
 

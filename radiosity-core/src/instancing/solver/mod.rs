@@ -34,6 +34,12 @@
 //!   shared by all its instances, so each ray is blocked by every instance's own geometry (the
 //!   other branches of a crown), not by the instance's average visibility. The brightness class
 //!   (below) bounds the traced light too.
+//! - daylight ([`InstancedConfig::daylight`]: the sun and the sky's cells as distant sources):
+//!   every own polygon, at the top and in every opened instance, gets it ray traced from its
+//!   place in the scene through the same nested BVHs (a beam is seen where a ray against it leaves
+//!   the scene); the top level's proxies get it as beams (the top level's own visibility) and hand
+//!   it on as direct light, so that below the top only the interreflected light travels in the
+//!   beams. See `daylight`.
 //!
 //! Reuse: the refinement of a level (hierarchy, links, leaf-resolution coefficients, visibility
 //! table) depends on its geometry and, through the BF criterion, on how bright its light is; it is
@@ -57,7 +63,7 @@
 //! One file per step an instance goes through, in the order [`solve_instanced`] takes them:
 //! `task` (the stack of instances to open; the level each gathers), `occluders` (the polygons
 //! above that cross a closed instance's box), `proxy` (closed instances' boxes from their
-//! properties), `direct` (the traced direct light), `cache` (brightness class, similarity and
+//! properties), `direct` (the traced direct light), `daylight` (the sun and the sky), `cache` (brightness class, similarity and
 //! the level cache), `level` (building, refining and solving a local problem), `outside` (the
 //! beams from outside and the visibility table), `sink` (streaming the finished polygons),
 //! `handoff` (the light passed on to the closed instances), `directional` (the proxies' light
@@ -66,6 +72,7 @@
 
 mod cache;
 mod config;
+mod daylight;
 mod direct;
 mod directional;
 pub mod distributed;
@@ -80,6 +87,7 @@ mod task;
 
 pub use cache::SIMILARITY_TOLERANCE;
 pub use config::{InstanceLevels, InstancedConfig, InstancedStats, LevelReuse, ProxyEmission};
+pub use daylight::{SKY_MAX_CELLS, SKY_RAYS_DIVISOR, TOP_MAX_POINTS, brightest as daylight_brightest};
 pub use occluders::MAX_INHERITED_OCCLUDERS;
 pub use outside::{FIELD_REL_MIN, LIGHT_DIRECTIONS, TABLE_DIRECTIONS, TABLE_RAYS};
 pub use proxy::{MAX_PROXY_REFLECTANCE, MIN_PROXY_EXTENT_REL};
@@ -147,7 +155,10 @@ fn solve_depth_first(scene: &InstancedScene, config: &InstancedConfig, driver: &
     let mut caster: Option<crate::instancing::InstanceCaster> = None;
     let mut direct_emitters: Vec<(Poly, [f64; 3])> = Vec::new();
     // Every local BF threshold stays relative to the scene's largest emission (see `build_level`).
-    let b_ref_scene = scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max);
+    // Under daylight, relative to the brightest radiosity it can give a surface.
+    let b_ref_scene =
+        scene.materials.iter().flat_map(|m| m.emission).fold(0.0, f64::max).max(daylight::brightest(&scene.materials, &config.daylight));
+    let diag = bounds[scene.root as usize].diagonal();
     // The smallest element is as large in every local problem as in the flattened solve (its
     // relative minimum times the whole scene's area), not relative to the small area of a twig,
     // which let a twig's leaves split ten thousand times finer than the full solve splits them.
@@ -174,6 +185,19 @@ fn solve_depth_first(scene: &InstancedScene, config: &InstancedConfig, driver: &
         if task.incoming.is_none() && tracing {
             direct_emitters = top_emitters(scene, &own);
         }
+        // Daylight is traced from the top level down: the caster is needed from the start.
+        if !config.daylight.is_empty() && caster.is_none() {
+            caster = Some(build_caster(scene, config.trace));
+        }
+        let top_daylight = match (&caster, task.incoming.is_none() && !config.daylight.is_empty()) {
+            (Some(c), true) => Some(daylight::TopDaylight {
+                traced: daylight::traced_daylight(scene, &own, task.flat_base, &config.daylight, c, (config.direct_samples, true), diag),
+                sources: &config.daylight,
+                samples: config.direct_samples,
+                tracked: tracing,
+            }),
+            _ => None,
+        };
         let child_occluders = child_occluders(&own, &task.occluders, &closed, &bounds);
         ensure_proxies(scene, &bounds, &hashes, cache.as_ref(), &closed, &mut proxies, &mut stats, &config.properties)?;
 
@@ -186,7 +210,13 @@ fn solve_depth_first(scene: &InstancedScene, config: &InstancedConfig, driver: &
         if tracing && task.incoming.is_some() && caster.is_none() {
             caster = Some(build_caster(scene, config.trace));
         }
-        let split = direct_split(scene, &task, &own, &direct_emitters, caster.as_ref(), config.direct_samples);
+        let mut split = direct_split(scene, &task, &own, &direct_emitters, caster.as_ref().filter(|_| tracing), config.direct_samples);
+        if let (Some(split), Some(c)) = (&mut split, &caster)
+            && !config.daylight.is_empty()
+        {
+            let traced = daylight::traced_daylight(scene, &own, task.flat_base, &config.daylight, c, (config.direct_samples, false), diag);
+            daylight::add_into(&mut split.traced, &traced);
+        }
         let class = light_class(&dirs, task.incoming.as_deref(), split.as_ref());
         let key = (task.prototype, inlined, class.map_or(i32::MIN, |c| c.0));
         let reused = if class.is_some() { levels.find(&key, &task.transform.matrix) } else { None };
@@ -198,7 +228,11 @@ fn solve_depth_first(scene: &InstancedScene, config: &InstancedConfig, driver: &
                 split: split.as_ref(),
                 raise,
             });
-            let Some(level) = build_level(scene, &task, &own, &closed, &proxies, light, (b_ref_scene, min_area), config)? else { continue };
+            let Some(level) =
+                build_level(scene, &task, &own, &closed, &proxies, light, top_daylight.as_ref(), (b_ref_scene, min_area), config)?
+            else {
+                continue;
+            };
             fresh = Some(level);
         }
         drop(own);
@@ -209,7 +243,10 @@ fn solve_depth_first(scene: &InstancedScene, config: &InstancedConfig, driver: &
         };
         stats.max_local_polygons = stats.max_local_polygons.max(level.polys.len());
 
-        let light = light_in_level(&dirs, similarity.as_ref(), &task, level, split.as_ref());
+        let mut light = light_in_level(&dirs, similarity.as_ref(), &task, level, split.as_ref());
+        if let Some(daylight) = level.daylight.take() {
+            light = daylight;
+        }
         let solution = solve_level(level, &light.external, config);
         if config.trace {
             trace_solve(&stats, &scene.prototype(task.prototype).name, level, closed.len(), similarity.is_some(), t_local);

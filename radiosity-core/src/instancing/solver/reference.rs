@@ -11,15 +11,18 @@ use crate::pipeline;
 use crate::refine::{ClassicBf, first_guess_max};
 
 /// The same scene solved fully: flattened (two-sided polygons as pairs) and given to
-/// [`pipeline::run`]; the per-polygon mean radiosity is returned in flattening order, with the
-/// solve's link count.
+/// [`pipeline::run`] (with the daylight of [`InstancedConfig::daylight`], which the plain solve
+/// takes like a luminaire's light, elements split along the sun's shadows); the per-polygon mean
+/// radiosity is returned in flattening order, with the solve's link count.
 pub fn solve_full(scene: &InstancedScene, config: &InstancedConfig) -> Result<(PolygonMeans, u64), InstancingError> {
-    let flat = crate::instancing::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
+    let mut flat = crate::instancing::flatten(scene, &FlattenOptions { two_sided_pairs: true })?;
+    flat.distant.clone_from(&config.daylight);
+    // Thresholds relative to the brightest radiosity, as the instanced solve's (the daylight's
+    // when it is brighter than the emitters').
+    let b_ref = first_guess_max(&flat).max(super::daylight::brightest(&flat.materials, &config.daylight));
     // No error estimate: the comparison measures the error, and the instanced solve has none either.
     // On a worker of the pool, as the instanced solve runs (a like-for-like comparison).
-    let solved = rayon::scope(|_| {
-        pipeline::run(&flat, &ClassicBf { eps: config.bf.eps, b_ref: first_guess_max(&flat) }, &local_pipeline(config), &|_| {})
-    });
+    let solved = rayon::scope(|_| pipeline::run(&flat, &ClassicBf { eps: config.bf.eps, b_ref }, &local_pipeline(config), &|_| {}));
     let mut means = PolygonMeans::default();
     let mut leaves = Vec::new();
     for i in 0..flat.polygons.len() {

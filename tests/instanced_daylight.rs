@@ -1,0 +1,293 @@
+//! The sun and the sky light instanced scenes (issue 18, item 1): the instanced solver against
+//! the flattened plain solve of the same scene under the same daylight, an unoccluded polygon's
+//! exact irradiance at every level, and `radiosity solve` of a scene file with `[sun]` and `[sky]`
+//! through the streaming output.
+
+use radiosity_core::daylight::{self, DistantSource, Site, SkyModel};
+use radiosity_core::geom::DVec3;
+use radiosity_core::instancing::properties::PropertyConfig;
+use radiosity_core::instancing::solver::relative_error;
+use radiosity_core::instancing::{
+    self, ForestParams, InstancedConfig, InstancedScene, Leaf, PolygonInfo, PolygonMeans, RadiositySink, generate_forest, solve_full,
+    solve_instanced,
+};
+use std::path::Path;
+use std::process::Command;
+
+/// Largest error of a polygon's mean radiosity, instanced against flattened, as a fraction of the
+/// flattened solve's largest (the sunlit ground's): a small generated tree (1,289 polygons) under
+/// a sun and a 46-cell sky, measured 0.145. The direct light agrees (each kind of polygon's
+/// sunlit power through the nested BVHs within 0.2% of brute force through the flattened scene,
+/// `diagnose_direct_sun`); the rest is the instanced model's interreflection: the light the ground
+/// reflects up reaches an opened instance as parallel beams binned by the links' directions, which
+/// gives tilted leaves less than a hemisphere of ground would (the leaves' light 4% low under sun
+/// and sky, 5% high with a black ground; under the generated lamps the same tree's leaves are
+/// 21–24% high, hidden there by the lamps' far larger radiosity), and single leaves differ by
+/// their few points against the plain solve's elements split along the sun's shadows.
+const TREE_MAX_TOL: f64 = 0.20;
+/// Area-weighted mean error of the same, measured 0.0166 (4 such trees: 0.046, max 0.279).
+const TREE_MEAN_TOL: f64 = 0.025;
+/// An unoccluded polygon's irradiance is a sum of `E·cos` terms, computed exactly: rounding only.
+const EXACT_TOL: f64 = 1e-9;
+
+fn daylight_sources(sky_cells: u32) -> Vec<DistantSource> {
+    let site = Site::default();
+    let mut sources = vec![daylight::sun(DVec3::new(0.3, 0.2, -0.93), [400.0, 380.0, 300.0], &site).unwrap().unwrap()];
+    sources.extend(daylight::sky(SkyModel::Uniform, [100.0, 90.0, 80.0], sky_cells, &site).unwrap());
+    sources
+}
+
+fn config(sources: Vec<DistantSource>) -> InstancedConfig {
+    InstancedConfig {
+        properties: PropertyConfig { n_directions: 16, rays_per_direction: 400, ..PropertyConfig::default() },
+        daylight: sources,
+        ..InstancedConfig::default()
+    }
+}
+
+/// A small generated tree on its ground, the lamps taken away: daylight only.
+fn small_tree() -> InstancedScene {
+    let mut scene = generate_forest(&ForestParams { trees: 1, min_age: 3, max_age: 4, spacing: 3.0, ..ForestParams::default() });
+    let root = scene.root as usize;
+    scene.prototypes[root].polygons.truncate(1);
+    scene
+}
+
+#[test]
+fn a_small_tree_under_sun_and_sky_matches_the_flattened_solve() {
+    let scene = small_tree();
+    let c = config(daylight_sources(46));
+    let t = std::time::Instant::now();
+    let (full, full_links) = solve_full(&scene, &c).unwrap();
+    let t_full = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let mut inst = PolygonMeans::default();
+    let stats = solve_instanced(&scene, &c, &mut inst).unwrap();
+    let t_inst = t.elapsed().as_secs_f64();
+    assert_eq!(inst.radiosity.len(), full.radiosity.len());
+    let (worst, mean) = relative_error(&full, &inst);
+    eprintln!(
+        "{} polygons: full {full_links} links {t_full:.2}s, instanced {} local solves {} links {t_inst:.2}s: max {:.4}%, mean {:.4}%",
+        full.radiosity.len(),
+        stats.local_solves,
+        stats.links,
+        100.0 * worst,
+        100.0 * mean
+    );
+    assert!(stats.local_solves > 1, "the trees must be solved as instances");
+    assert!(worst <= TREE_MAX_TOL, "max error {worst}");
+    assert!(mean <= TREE_MEAN_TOL, "mean error {mean}");
+    // Daylight reached the leaves below the top: no polygon of the tree is black.
+    let lit = inst.radiosity.iter().filter(|b| b.iter().any(|&x| x > 0.0)).count();
+    assert!(lit * 10 >= inst.radiosity.len() * 9, "{lit} of {} polygons lit", inst.radiosity.len());
+}
+
+/// Keeps each polygon's mean irradiance.
+#[derive(Default)]
+struct Irradiance(Vec<[f64; 3]>);
+
+impl RadiositySink for Irradiance {
+    fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), instancing::InstancingError> {
+        let i = info.flat_index as usize;
+        if self.0.len() <= i {
+            self.0.resize(i + 1, [0.0; 3]);
+        }
+        self.0[i] = instancing::solver::leaf_means(leaves).2;
+        Ok(())
+    }
+}
+
+const OPEN_SKY: &str = r#"
+[[material]]
+name = "black"
+reflectance = 0.0
+[[material]]
+name = "grey"
+reflectance = 0.5
+
+[[polygon]]
+material = "black"
+vertices = [[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0]]
+
+# Tilted toward the sun, high above the rest.
+[[polygon]]
+material = "grey"
+vertices = [[2, 2, 6], [3, 2, 6.5], [3, 3, 6.5], [2, 3, 6]]
+
+[[prototype]]
+name = "cube"
+[[prototype.box]]
+min = [0, 0, 0]
+max = [1, 1, 1]
+material = "grey"
+
+[[instance]]
+of = "cube"
+translate = [6, 6, 1]
+"#;
+
+/// A polygon in full sun and open sky gets exactly `Σ E·max(0, −n·toward)`: at the top level
+/// (the tilted quad) and inside an opened instance (the cube's top face, traced through the
+/// nested BVHs).
+#[test]
+fn unoccluded_polygons_get_e_cos_exactly() {
+    let scene = instancing::parse(OPEN_SKY, Path::new("open.toml"), Path::new(".")).unwrap();
+    let sources = daylight_sources(46);
+    let mut sink = Irradiance::default();
+    let stats = solve_instanced(&scene, &config(sources.clone()), &mut sink).unwrap();
+    assert_eq!(stats.local_solves, 2, "the cube is an instance");
+    let expected = |n: DVec3| -> [f64; 3] {
+        let mut e = [0.0; 3];
+        for s in &sources {
+            let on = s.on(n);
+            for c in 0..3 {
+                e[c] += on[c];
+            }
+        }
+        e
+    };
+    let flat = instancing::flatten(&scene, &instancing::FlattenOptions { two_sided_pairs: true }).unwrap();
+    let mut checked = 0;
+    for (i, p) in flat.polygons.iter().enumerate() {
+        let n = p.poly.normal();
+        let c = p.poly.centroid();
+        // The tilted quad (z ≥ 6), the cube's top face (z = 2, facing up).
+        let tilted = c.z > 5.0;
+        let cube_top = (c.z - 2.0).abs() < 1e-9 && n.z > 0.99;
+        if !(tilted || cube_top) {
+            continue;
+        }
+        let want = expected(n);
+        for ch in 0..3 {
+            assert!((sink.0[i][ch] - want[ch]).abs() <= EXACT_TOL * want[ch], "polygon {i}: {:?} vs {want:?}", sink.0[i]);
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, 2);
+}
+
+/// `radiosity solve` of an instanced scene file with `[sun]` and `[sky]` solves it instanced
+/// (not flattened) and writes the streamed outputs.
+#[test]
+fn cli_solves_an_instanced_scene_under_daylight() {
+    let dir = std::env::temp_dir().join(format!("radiosity-instanced-daylight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.toml");
+    let text = format!(
+        "{OPEN_SKY}\n[sun]\ndirection = [0.3, 0.2, -0.93]\ndirect_normal = 400.0\n[sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = 100.0\ndirections = 46\n"
+    );
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["solve", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"])
+        .output()
+        .expect("the binary runs");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["local_solves"], 2, "solved instanced: {stats}");
+    let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    assert!(patches.lines().count() > 8, "{patches}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Where the instanced solve departs from the flattened one, by material and side (run by hand).
+#[test]
+#[ignore = "diagnostic"]
+fn diagnose_by_material() {
+    let trees: u32 = std::env::var("TREES").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
+    let mut scene = generate_forest(&ForestParams { trees, min_age: 3, max_age: 4, spacing: 3.0, ..ForestParams::default() });
+    let root = scene.root as usize;
+    let lamps = std::env::var("LAMPS").is_ok();
+    if !lamps {
+        scene.prototypes[root].polygons.truncate(1);
+    }
+    if std::env::var("BLACKGROUND").is_ok() {
+        let g = scene.find_material("ground").unwrap() as usize;
+        scene.materials[g].reflectance = [0.0; 3];
+    }
+    let cells: u32 = std::env::var("CELLS").ok().and_then(|s| s.parse().ok()).unwrap_or(46);
+    let mut sources = daylight_sources(cells);
+    if std::env::var("NOSKY").is_ok() {
+        sources.truncate(1);
+    }
+    if std::env::var("NOSUN").is_ok() {
+        sources.remove(0);
+    }
+    let c = config(if lamps { Vec::new() } else { sources });
+    let (full, _) = solve_full(&scene, &c).unwrap();
+    let mut inst = PolygonMeans::default();
+    let _ = solve_instanced(&scene, &c, &mut inst).unwrap();
+    let flat = instancing::flatten(&scene, &instancing::FlattenOptions { two_sided_pairs: true }).unwrap();
+    let (worst, mean) = relative_error(&full, &inst);
+    eprintln!("{} polygons: max {:.3}% mean {:.3}%", flat.polygons.len(), 100.0 * worst, 100.0 * mean);
+    let mut sums: std::collections::BTreeMap<String, (f64, f64, f64, usize)> = Default::default();
+    let mut prev_leaf = false;
+    for (i, p) in flat.polygons.iter().enumerate() {
+        let m = &flat.materials[p.material as usize];
+        let side = if m.two_sided { if prev_leaf { "back" } else { "front" } } else { "" };
+        prev_leaf = m.two_sided && !prev_leaf;
+        let a = p.poly.area();
+        let e = sums.entry(format!("{} {side}", m.name)).or_default();
+        e.0 += a * full.radiosity[i][1];
+        e.1 += a * inst.radiosity[i][1];
+        e.2 += a * (full.radiosity[i][1] - inst.radiosity[i][1]).abs();
+        e.3 += 1;
+    }
+    for (k, (f, s, d, n)) in &sums {
+        eprintln!("{k}: {n} polygons, full {f:.4e} instanced {s:.4e} (ratio {:.4}), mean |diff| / mean {:.4}", s / f, d / f);
+    }
+}
+
+/// The sun's direct light on each kind of polygon: the plain solve's (its elements' quadrature),
+/// brute force through the flattened scene's caster and through the nested BVHs (run by hand).
+#[test]
+#[ignore = "diagnostic"]
+fn diagnose_direct_sun() {
+    use radiosity_core::visibility::{RayCaster, Rng};
+    let mut scene = generate_forest(&ForestParams { trees: 1, min_age: 3, max_age: 4, spacing: 3.0, ..ForestParams::default() });
+    let root = scene.root as usize;
+    scene.prototypes[root].polygons.truncate(1);
+    let sources = daylight_sources(46)[..1].to_vec();
+    let c = config(sources.clone());
+    let mut flat = instancing::flatten(&scene, &instancing::FlattenOptions { two_sided_pairs: true }).unwrap();
+    flat.distant = sources.clone();
+    let b_ref = instancing::solver::daylight_brightest(&flat.materials, &sources);
+    let solved = radiosity_core::pipeline::run(
+        &flat,
+        &radiosity_core::refine::ClassicBf { eps: c.bf.eps, b_ref },
+        &radiosity_core::pipeline::Config { levels: 1, estimate_error: false, detect_closure: false, ..c.pipeline },
+        &|_| {},
+    );
+    let caster = RayCaster::new(&flat);
+    let nested = instancing::InstanceCaster::new(&scene);
+    let diag = flat.bounds().diagonal();
+    let light = daylight::DistantLight::new(&sources, Some(&caster), diag);
+    let mut sums: std::collections::BTreeMap<String, [f64; 4]> = Default::default();
+    for (i, p) in flat.polygons.iter().enumerate() {
+        let m = &flat.materials[p.material as usize];
+        let n = p.poly.normal();
+        let mut rng = Rng::for_link(9, i as u32, 0);
+        let (mut plain, mut nest) = (0.0, 0.0);
+        const N: usize = 256;
+        for _ in 0..N {
+            let x = p.poly.sample(rng.next_f64(), rng.next_f64());
+            plain += light.at(x, n, i as u32)[1];
+            let e = sources[0].on(n)[1];
+            if e > 0.0 {
+                let a = x + n * 1e-5 * diag;
+                if nested.segment_clear(a, a - sources[0].toward * 1.01 * diag) {
+                    nest += e;
+                }
+            }
+        }
+        let a = p.poly.area();
+        let s = sums.entry(m.name.clone()).or_default();
+        s[0] += a * solved.hierarchy.direct[i][1];
+        s[1] += a * plain / N as f64;
+        s[2] += a * nest / N as f64;
+        s[3] += a;
+    }
+    for (k, s) in &sums {
+        eprintln!("{k}: plain solve {:.4e}, brute force flat {:.4e}, nested {:.4e} (area {:.3e})", s[0], s[1], s[2], s[3]);
+    }
+}
