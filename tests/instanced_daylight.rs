@@ -190,6 +190,76 @@ fn cli_solves_an_instanced_scene_under_daylight() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A scene with named bands solved instanced: `patches.csv` and `groups.csv` name the bands, an
+/// unoccluded polygon absorbs exactly `A·(1 − ρ − t)·Σ E·cos` in each band, `groups.csv` sums
+/// the rows of each prototype, and `stats.json` holds the bands and their absorbed power.
+#[test]
+fn cli_instanced_bands_report_absorbed_power() {
+    let dir = std::env::temp_dir().join(format!("radiosity-instanced-bands-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene_path = dir.join("scene.toml");
+    let geometry = OPEN_SKY.replace("reflectance = 0.5", "reflectance = [0.2, 0.6]").replace("reflectance = 0.0", "reflectance = [0.0, 0.0]");
+    let text = format!(
+        "bands = [\"PAR\", \"NIR\"]\n{geometry}\n[sun]\ndirection = [0.3, 0.2, -0.93]\ndirect_normal = [400.0, 380.0]\n[sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = [100.0, 90.0]\ndirections = 46\n"
+    );
+    std::fs::write(&scene_path, &text).unwrap();
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["solve", scene_path.to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"])
+        .output()
+        .expect("the binary runs");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    let mut lines = patches.lines();
+    assert_eq!(lines.next(), Some("index,group,material,area,b_PAR,b_NIR,h_PAR,h_NIR,units,absorbed_PAR,absorbed_NIR"));
+    let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_owned).collect()).collect();
+    let num = |r: &[String], k: usize| r[k].parse::<f64>().unwrap();
+
+    // The exact irradiance of the cube's top face (z = 2, facing up, in the open).
+    let site = Site::default();
+    let mut sources = vec![daylight::sun(DVec3::new(0.3, 0.2, -0.93), [400.0, 380.0, 0.0], &site).unwrap().unwrap()];
+    sources.extend(daylight::sky(SkyModel::CieOvercast, [100.0, 90.0, 0.0], 46, &site).unwrap());
+    let e: [f64; 2] = std::array::from_fn(|c| sources.iter().map(|s| s.on(DVec3::Z)[c]).sum());
+    let scene = instancing::load(&scene_path).unwrap();
+    let flat = instancing::flatten(&scene, &instancing::FlattenOptions { two_sided_pairs: true }).unwrap();
+    let top = flat
+        .polygons
+        .iter()
+        .position(|p| (p.poly.centroid().z - 2.0).abs() < 1e-9 && p.poly.normal().z > 0.99)
+        .expect("the cube's top face");
+    let row = rows.iter().find(|r| r[0] == top.to_string()).expect("its row");
+    for (c, rho) in [0.2, 0.6].into_iter().enumerate() {
+        let want = num(row, 3) * (1.0 - rho) * e[c];
+        assert!((num(row, 9 + c) - want).abs() <= EXACT_TOL * want, "band {c}: {} vs {want}", num(row, 9 + c));
+    }
+
+    // groups.csv: one row per prototype holding polygons, the sums of its rows.
+    let groups = std::fs::read_to_string(out.join("groups.csv")).unwrap();
+    let mut glines = groups.lines();
+    assert_eq!(glines.next(), Some("group,area,absorbed_PAR,absorbed_NIR"));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["bands"], serde_json::json!(["PAR", "NIR"]));
+    let mut total = [0.0; 2];
+    for g in glines {
+        let g: Vec<String> = g.split(',').map(str::to_owned).collect();
+        let mine: Vec<&Vec<String>> = rows.iter().filter(|r| r[1] == g[0]).collect();
+        assert!(!mine.is_empty(), "group {} has rows", g[0]);
+        for (k, col) in [(1, 3), (2, 9), (3, 10)] {
+            let sum: f64 = mine.iter().map(|r| num(r, col)).sum();
+            assert!((num(&g, k) - sum).abs() <= 1e-9 * sum.abs().max(1e-300), "group {} column {k}: {} vs {sum}", g[0], g[k]);
+        }
+        total[0] += num(&g, 2);
+        total[1] += num(&g, 3);
+    }
+    for (c, band) in ["PAR", "NIR"].into_iter().enumerate() {
+        let reported = stats["absorbed_by_band"][band].as_f64().unwrap();
+        assert!((reported - total[c]).abs() <= 1e-9 * total[c], "{band}: {reported} vs {}", total[c]);
+    }
+    // The black ground absorbs what reaches it: more than the cube and quad together.
+    assert!(total[0] > 100.0 * 50.0, "PAR absorbed {}", total[0]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Where the instanced solve departs from the flattened one, by material and side (run by hand).
 #[test]
 #[ignore = "diagnostic"]

@@ -176,7 +176,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             lit_scene = Some(plain);
         } else {
             refuse_plain_only(args)?;
-            return solve_instanced(args, &scene, None, lighting.bands.pack_distant(0));
+            return solve_instanced(args, &scene, None, &lighting.bands);
         }
     }
     #[cfg(feature = "mpi")]
@@ -192,7 +192,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             }
             println!("{} in {:.3}s", auto.report, t0.elapsed().as_secs_f64());
         }
-        return solve_instanced(args, &auto.scene, Some(&auto.report), Vec::new());
+        return solve_instanced(args, &auto.scene, Some(&auto.report), &radiosity::instancing::bands::Bands::default());
     }
     let t0 = Instant::now();
     let reporter = Reporter::new(args.quiet);
@@ -481,12 +481,15 @@ fn write_grids(
 /// report goes to `stats.json`): solved depth-first, one instance open at a time, finished polygons
 /// streamed to `patches.csv` and a spool from which `solution.ply`, `solution.glb` and `image.png` are written at
 /// the end (see `radiosity::instancing::output`); `stats.json` holds the instanced solver's figures.
-/// `daylight`: the scene file's sun and sky.
+/// `bands`: the scene file's bands (at most three, [`Lighting::needs_plain_solve`] sends more to
+/// the plain solve), sun and sky.
+///
+/// [`Lighting::needs_plain_solve`]: radiosity::instancing::Lighting::needs_plain_solve
 fn solve_instanced(
     args: &SolveArgs,
     scene: &radiosity::instancing::InstancedScene,
     auto: Option<&radiosity::instancing::AutoReport>,
-    daylight: Vec<radiosity::daylight::DistantSource>,
+    bands: &radiosity::instancing::bands::Bands,
 ) -> anyhow::Result<()> {
     use radiosity::instancing::{InstancedConfig, StreamedOutput};
     let t0 = Instant::now();
@@ -499,7 +502,7 @@ fn solve_instanced(
     config.level_cache_bytes = (args.level_cache_mb * 1e6) as usize;
     config.instance_levels = args.instance_levels;
     config.direct_samples = args.direct_samples;
-    config.daylight = daylight;
+    config.daylight = bands.pack_distant(0);
     config.proxy_emission = args.proxy_emission;
     config.level_reuse = args.level_reuse;
     // Over MPI ranks (feature `mpi`), levels are reused within a subtree; ranks other than 0 solve
@@ -512,7 +515,8 @@ fn solve_instanced(
         }
     }
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
-    let mut sink = Progressing { inner: StreamedOutput::create(&args.out, scene)?, done: 0, total, reporter: Reporter::new(args.quiet) };
+    let output = if bands.declared { StreamedOutput::with_bands(&args.out, scene, &bands.names)? } else { StreamedOutput::create(&args.out, scene)? };
+    let mut sink = Progressing { inner: output, done: 0, total, reporter: Reporter::new(args.quiet) };
     #[cfg(feature = "mpi")]
     let (stats, mpi_report) = super::mpi::solve(scene, &config, &mut sink)?;
     #[cfg(not(feature = "mpi"))]
@@ -530,6 +534,20 @@ fn solve_instanced(
     doc["oracle"] = serde_json::json!("bf-hand");
     doc["eps"] = serde_json::json!(args.options.eps());
     doc["tone_white"] = serde_json::json!(written.white);
+    // Absorbed power per band (W), as groups.csv sums it; like the plain solve's `power_absorbed`,
+    // the sum over named bands or the mean over r, g, b. The instanced solve does not trace the
+    // light that leaves the scene: no `power_incident`, `power_escaped` or balance here.
+    let absorbed: serde_json::Map<String, serde_json::Value> =
+        written.bands.iter().zip(&written.absorbed).map(|(n, a)| (n.clone(), serde_json::json!(a))).collect();
+    let total: f64 = written.absorbed.iter().sum();
+    doc["power_absorbed"] = serde_json::json!(if bands.declared { total } else { total / 3.0 });
+    doc["absorbed_by_band"] = serde_json::Value::Object(absorbed);
+    if bands.declared {
+        doc["bands"] = serde_json::json!(bands.names);
+    }
+    if let Some(sun) = &bands.sun_report {
+        doc["sun"] = serde_json::to_value(sun).context("serialising the sun")?;
+    }
     doc["time_s"] =
         serde_json::json!({ "solve": stats.seconds, "output": t_out.elapsed().as_secs_f64(), "total": t0.elapsed().as_secs_f64() });
     doc["peak_rss_bytes"] = serde_json::json!(output::peak_rss_bytes());
@@ -554,9 +572,9 @@ fn solve_instanced(
             output::peak_rss_bytes().map_or("n/a".to_string(), |b| format!("{:.1} MB", b as f64 / 1e6))
         );
         let files = if args.no_image {
-            "solution.ply,solution.glb,patches.csv,stats.json"
+            "solution.ply,solution.glb,patches.csv,groups.csv,stats.json"
         } else {
-            "image.png,solution.ply,solution.glb,patches.csv,stats.json"
+            "image.png,solution.ply,solution.glb,patches.csv,groups.csv,stats.json"
         };
         println!("wrote {}/{{{files}}}", args.out.display());
     }

@@ -10,6 +10,13 @@
 //! the PLY, the GLB and the image are flat-shaded per leaf (no smoothing across leaves, which would need the
 //! neighbours in memory); the image is seen from the side (looking along +y, z up: the plant
 //! generator's convention), as instanced scene files carry no camera.
+//!
+//! Like the plain solve's, `patches.csv` ends with `absorbed_<band>` (W: `A·(1 − ρ − t)·H` of the
+//! polygon's side, the two sides of a leaf in two rows) and `groups.csv` sums the area and the
+//! absorbed power per group, here per prototype (`group,area,absorbed_<band>...`). A scene that
+//! names its bands (at most three solve instanced, see [`StreamedOutput::with_bands`]) gets their
+//! names in the columns instead of `r`, `g`, `b`, and its first band in grey in the PLY, the GLB
+//! and the image, as the plain solve shows it.
 
 use super::InstancingError;
 use super::model::InstancedScene;
@@ -43,6 +50,14 @@ pub struct StreamedOutput {
     vertices: u64,
     histogram: Vec<u64>,
     max_b: f64,
+    /// Column suffixes: `r`, `g`, `b` or the scene's band names (1 to 3).
+    bands: Vec<String>,
+    /// Whether the pictures show the first band in grey (named bands).
+    grey: bool,
+    /// `1 − ρ − t` per material and channel.
+    absorptance: Vec<[f64; 3]>,
+    /// Area and absorbed power per prototype.
+    groups: Vec<(f64, [f64; 3])>,
 }
 
 /// What [`StreamedOutput::finish`] wrote.
@@ -52,6 +67,10 @@ pub struct StreamedSummary {
     pub leaves: u64,
     /// Radiosity shown as white in the PLY colours and the image (W/m²).
     pub white: f64,
+    /// The bands, as `patches.csv` and `groups.csv` name them.
+    pub bands: Vec<String>,
+    /// Power absorbed by all the polygons, per band (W).
+    pub absorbed: Vec<f64>,
 }
 
 fn io_err(path: &Path, e: std::io::Error) -> InstancingError {
@@ -59,14 +78,30 @@ fn io_err(path: &Path, e: std::io::Error) -> InstancingError {
 }
 
 impl StreamedOutput {
-    /// Creates `dir` and opens `patches.csv` and the spool in it.
+    /// Creates `dir` and opens `patches.csv` and the spool in it (RGB columns).
     pub fn create(dir: &Path, scene: &InstancedScene) -> Result<StreamedOutput, InstancingError> {
+        Self::with_bands(dir, scene, &["r", "g", "b"])
+    }
+
+    /// [`StreamedOutput::create`] for a scene whose materials hold the bands `names` (1 to 3; the
+    /// channels past them are not written).
+    pub fn with_bands(dir: &Path, scene: &InstancedScene, names: &[impl AsRef<str>]) -> Result<StreamedOutput, InstancingError> {
+        if names.is_empty() || names.len() > 3 {
+            return Err(InstancingError::io(
+                dir,
+                "cannot write an instanced solve's outputs",
+                std::io::Error::other(format!("{} bands (the instanced solve takes 1 to 3)", names.len())),
+            ));
+        }
+        let bands: Vec<String> = names.iter().map(|n| n.as_ref().to_owned()).collect();
         std::fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
         let spool_path = dir.join("solution.spool");
         let spool = BufWriter::new(std::fs::File::create(&spool_path).map_err(|e| io_err(&spool_path, e))?);
         let csv_path = dir.join("patches.csv");
         let mut csv = AtomicFile::create(&csv_path).map_err(|e| io_err(&csv_path, e))?;
-        writeln!(csv, "index,group,material,area,b_r,b_g,b_b,h_r,h_g,h_b,units").map_err(|e| io_err(&csv_path, e))?;
+        let column = |prefix: &str| bands.iter().map(|n| format!(",{prefix}_{n}")).collect::<String>();
+        writeln!(csv, "index,group,material,area{}{},units{}", column("b"), column("h"), column("absorbed"))
+            .map_err(|e| io_err(&csv_path, e))?;
         Ok(StreamedOutput {
             dir: dir.to_owned(),
             spool_path,
@@ -81,6 +116,14 @@ impl StreamedOutput {
             vertices: 0,
             histogram: vec![0; TONE_BINS],
             max_b: 0.0,
+            grey: bands.iter().map(String::as_str).ne(["r", "g", "b"]),
+            bands,
+            absorptance: scene
+                .materials
+                .iter()
+                .map(|m| std::array::from_fn(|c| 1.0 - m.reflectance[c] - m.transmittance[c]))
+                .collect(),
+            groups: vec![(0.0, [0.0; 3]); scene.prototypes.len()],
         })
     }
 
@@ -110,6 +153,7 @@ impl StreamedOutput {
         if let Some(csv) = self.csv.take() {
             csv.commit().map_err(|e| io_err(&self.csv_path, e))?;
         }
+        self.write_groups()?;
         self.spool.flush().map_err(|e| io_err(&self.spool_path, e))?;
         let tone = self.tone();
         self.write_ply(&tone)?;
@@ -120,7 +164,24 @@ impl StreamedOutput {
             crate::output::write_png(&png, &rgb, render.width, render.height)
                 .map_err(|e| InstancingError::io(&png, "cannot write image", std::io::Error::other(e)))?;
         }
-        Ok(StreamedSummary { leaves: self.leaves, white: tone.white })
+        let nb = self.bands.len();
+        let absorbed = (0..nb).map(|c| self.groups.iter().map(|g| g.1[c]).sum()).collect();
+        Ok(StreamedSummary { leaves: self.leaves, white: tone.white, bands: self.bands.clone(), absorbed })
+    }
+
+    /// `groups.csv`: area and absorbed power per prototype holding polygons, in the scene's order.
+    fn write_groups(&self) -> Result<(), InstancingError> {
+        let path = self.dir.join("groups.csv");
+        let mut w = AtomicFile::create(&path).map_err(|e| io_err(&path, e))?;
+        let header = self.bands.iter().map(|n| format!(",absorbed_{n}")).collect::<String>();
+        let mut result = writeln!(w, "group,area{header}");
+        for (name, (area, absorbed)) in self.prototype_names.iter().zip(&self.groups) {
+            if *area > 0.0 && result.is_ok() {
+                let values = absorbed[..self.bands.len()].iter().map(|v| format!(",{v:e}")).collect::<String>();
+                result = writeln!(w, "{},{area:e}{values}", crate::output::csv_field(name));
+            }
+        }
+        result.and_then(|()| w.commit()).map_err(|e| io_err(&path, e))
     }
 
     /// Calls `f` on every spooled leaf: its vertices and radiosity.
@@ -298,7 +359,8 @@ impl RadiositySink for StreamedOutput {
                     rec.extend_from_slice(&(x as f32).to_le_bytes());
                 }
             }
-            for x in leaf.b {
+            let b = if self.grey { [leaf.b[0]; 3] } else { leaf.b };
+            for x in b {
                 rec.extend_from_slice(&(x as f32).to_le_bytes());
             }
             self.spool.write_all(&rec).map_err(|e| io_err(&self.spool_path, e))?;
@@ -306,7 +368,7 @@ impl RadiositySink for StreamedOutput {
             self.vertices += vs.len() as u64;
         }
         let emitter = self.emitter.get(info.material as usize).copied().unwrap_or(false);
-        let lum = b[0].max(b[1]).max(b[2]);
+        let lum = if self.grey { b[0] } else { b[0].max(b[1]).max(b[2]) };
         if !emitter && lum.is_finite() && lum > 0.0 {
             let bin = ((lum / TONE_MIN).log10() * TONE_BINS_PER_DECADE).floor().clamp(0.0, (TONE_BINS - 1) as f64) as usize;
             self.histogram[bin] += 1;
@@ -314,22 +376,25 @@ impl RadiositySink for StreamedOutput {
         }
         let group = self.prototype_names.get(info.prototype as usize).map_or("", String::as_str);
         let material = self.material_names.get(info.material as usize).map_or("", String::as_str);
+        let alpha = self.absorptance.get(info.material as usize).copied().unwrap_or([0.0; 3]);
+        let absorbed: [f64; 3] = std::array::from_fn(|c| area * alpha[c] * h[c]);
+        if let Some(g) = self.groups.get_mut(info.prototype as usize) {
+            g.0 += area;
+            for c in 0..3 {
+                g.1[c] += absorbed[c];
+            }
+        }
+        let nb = self.bands.len();
         let Some(csv) = self.csv.as_mut() else { return Err(io_err(&self.csv_path, std::io::Error::other("already finished"))) };
-        writeln!(
-            csv,
-            "{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},W/m2",
-            info.flat_index,
-            crate::output::csv_field(group),
-            crate::output::csv_field(material),
-            area,
-            b[0],
-            b[1],
-            b[2],
-            h[0],
-            h[1],
-            h[2]
-        )
-        .map_err(|e| io_err(&self.csv_path, e))
+        let mut row = format!("{},{},{},{area:e}", info.flat_index, crate::output::csv_field(group), crate::output::csv_field(material));
+        for v in b[..nb].iter().chain(&h[..nb]) {
+            row.push_str(&format!(",{v:e}"));
+        }
+        row.push_str(",W/m2");
+        for v in &absorbed[..nb] {
+            row.push_str(&format!(",{v:e}"));
+        }
+        writeln!(csv, "{row}").map_err(|e| io_err(&self.csv_path, e))
     }
 }
 
