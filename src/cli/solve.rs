@@ -163,7 +163,11 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     if toml {
         let path = args.scene.as_ref().expect("checked above");
         let (scene, lighting) = radiosity::instancing::load_with_lighting(path)?;
-        if lighting.needs_plain_solve() || !scene.grids.is_empty() || has_grids {
+        // Daylight on a scene without instances takes the plain solve, which splits elements
+        // along the sun's shadows and refines to the error target; with instances, the instanced
+        // solve traces it through the nested BVHs.
+        let flat_daylight = lighting.bands.has_daylight() && scene.prototypes[scene.root as usize].instances.is_empty();
+        if lighting.needs_plain_solve() || flat_daylight || !scene.grids.is_empty() || has_grids {
             anyhow::ensure!(args.instances == Instances::None, "--instances auto applies to plain OBJ / MGF scenes");
             let mut plain = radiosity::instancing::flatten(&scene, &radiosity::instancing::FlattenOptions::default())?;
             plain.luminaires = lighting.luminaires;
@@ -516,14 +520,16 @@ fn solve_instanced(
     }
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
     let output = if bands.declared { StreamedOutput::with_bands(&args.out, scene, &bands.names)? } else { StreamedOutput::create(&args.out, scene)? };
+    // Under the sun and sky, the power balance is measured beside the output.
+    let output = radiosity::instancing::balance::DaylightBalance::new(output, scene, &config.daylight);
     let mut sink = Progressing { inner: output, done: 0, total, reporter: Reporter::new(args.quiet) };
     #[cfg(feature = "mpi")]
     let (stats, mpi_report) = super::mpi::solve(scene, &config, &mut sink)?;
     #[cfg(not(feature = "mpi"))]
     let stats = radiosity::instancing::solve_instanced(scene, &config, &mut sink)?;
     sink.reporter.finish();
-    let sink = sink.inner;
     let t_out = Instant::now();
+    let (sink, balance) = sink.inner.finish();
     let render = output::RenderConfig { width: args.size, height: args.size, ..Default::default() };
     let written = sink.finish((!args.no_image).then_some(&render))?;
     let mut doc = serde_json::to_value(&stats).context("serialising stats")?;
@@ -535,13 +541,39 @@ fn solve_instanced(
     doc["eps"] = serde_json::json!(args.options.eps());
     doc["tone_white"] = serde_json::json!(written.white);
     // Absorbed power per band (W), as groups.csv sums it; like the plain solve's `power_absorbed`,
-    // the sum over named bands or the mean over r, g, b. The instanced solve does not trace the
-    // light that leaves the scene: no `power_incident`, `power_escaped` or balance here.
+    // the sum over named bands or the mean over r, g, b. Under daylight, the balance's terms
+    // (radiosity::instancing::balance) as the plain solve's keys.
+    let nb = written.bands.len();
+    let combine = |v: &[f64]| -> f64 {
+        let total: f64 = v[..nb].iter().sum();
+        if bands.declared { total } else { total / 3.0 }
+    };
     let absorbed: serde_json::Map<String, serde_json::Value> =
         written.bands.iter().zip(&written.absorbed).map(|(n, a)| (n.clone(), serde_json::json!(a))).collect();
-    let total: f64 = written.absorbed.iter().sum();
-    doc["power_absorbed"] = serde_json::json!(if bands.declared { total } else { total / 3.0 });
+    doc["power_absorbed"] = serde_json::json!(combine(&written.absorbed));
     doc["absorbed_by_band"] = serde_json::Value::Object(absorbed);
+    if let Some(b) = &balance {
+        let by_band: serde_json::Map<String, serde_json::Value> = written
+            .bands
+            .iter()
+            .enumerate()
+            .map(|(c, n)| {
+                let band = output::BandPower { emitted: b.emitted[c], incident: b.incident[c], absorbed: b.absorbed[c], escaped: b.escaped[c] };
+                (n.clone(), serde_json::to_value(band).expect("plain numbers"))
+            })
+            .collect();
+        let total = output::BandPower::sum((0..nb).map(|c| output::BandPower {
+            emitted: b.emitted[c],
+            incident: b.incident[c],
+            absorbed: b.absorbed[c],
+            escaped: b.escaped[c],
+        }));
+        doc["power_emitted"] = serde_json::json!(combine(&b.emitted));
+        doc["power_incident"] = serde_json::json!(combine(&b.incident));
+        doc["power_escaped"] = serde_json::json!(combine(&b.escaped));
+        doc["power_balance"] = serde_json::json!(total.balance(true));
+        doc["power_by_band"] = serde_json::Value::Object(by_band);
+    }
     if bands.declared {
         doc["bands"] = serde_json::json!(bands.names);
     }
@@ -571,6 +603,17 @@ fn solve_instanced(
             t0.elapsed().as_secs_f64(),
             output::peak_rss_bytes().map_or("n/a".to_string(), |b| format!("{:.1} MB", b as f64 / 1e6))
         );
+        if let Some(b) = &balance {
+            for (c, n) in written.bands.iter().enumerate() {
+                println!(
+                    "{n}: incident {:.6e} W, absorbed {:.6e} W, escaped {:.6e} W, balance {}",
+                    b.incident[c],
+                    b.absorbed[c],
+                    b.escaped[c],
+                    b.ratio(c).map_or("n/a".to_string(), |r| format!("{r:.4}"))
+                );
+            }
+        }
         let files = if args.no_image {
             "solution.ply,solution.glb,patches.csv,groups.csv,stats.json"
         } else {

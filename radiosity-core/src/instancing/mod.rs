@@ -59,6 +59,7 @@
 //! account for the transmittance.
 
 pub mod auto;
+pub mod balance;
 pub mod bands;
 pub mod bench;
 pub mod caster;

@@ -87,7 +87,7 @@ mod task;
 
 pub use cache::SIMILARITY_TOLERANCE;
 pub use config::{InstanceLevels, InstancedConfig, InstancedStats, LevelReuse, ProxyEmission};
-pub use daylight::{SKY_MAX_CELLS, SKY_RAYS_DIVISOR, TOP_MAX_POINTS, brightest as daylight_brightest};
+pub use daylight::{SKY_MAX_CELLS, SKY_RAYS_DIVISOR, TOP_MAX_POINTS, TOP_POINT_AREA_REL, brightest as daylight_brightest};
 pub use occluders::MAX_INHERITED_OCCLUDERS;
 pub use outside::{FIELD_REL_MIN, LIGHT_DIRECTIONS, TABLE_DIRECTIONS, TABLE_RAYS};
 pub use proxy::{MAX_PROXY_REFLECTANCE, MIN_PROXY_EXTENT_REL};

@@ -1,0 +1,219 @@
+//! The power balance of an instanced solve under the sun and sky: `absorbed + escaped =
+//! incident + emitted`, each side measured apart from the solver, so that the balance checks it.
+//! Without distant sources [`DaylightBalance`] only passes polygons on.
+//!
+//! - **Incident**: what the distant sources deliver to the surfaces, from the sources alone. For
+//!   each source, a stratified grid of [`INCIDENT_GRID`]² parallel rays, jittered, covers the
+//!   scene's box as seen along the beam; each ray that meets a polygon (through the nested BVHs,
+//!   [`InstanceCaster`]) carries `E` times its cell's area.
+//! - **Escaped**: what leaves the surfaces for good, from the radiosity the solve streams out.
+//!   For each finished polygon, [`ESCAPE_RAYS`] points over its leaves (by area) each send one
+//!   cosine-distributed ray; those that meet nothing carry `B·A/N` of their leaf's radiosity out.
+//!   Seeded by the polygon's flattened index: the same figure whatever order polygons arrive in.
+//! - **Absorbed**: `A·(1 − ρ − t)·H` summed over the polygons (as `patches.csv` has it).
+//!
+//! Both estimates are Monte Carlo: their noise, not the solve, sets how closely the balance can be
+//! read (see `tests/instanced_daylight.rs` for what was measured).
+
+use super::InstancingError;
+use super::caster::InstanceCaster;
+use super::model::InstancedScene;
+use super::solver::{Leaf, PolygonInfo, RadiositySink};
+use crate::daylight::DistantSource;
+use crate::geom::{Aabb, DVec3, Poly};
+use rayon::prelude::*;
+
+/// Rays per polygon for the escaped power.
+pub const ESCAPE_RAYS: u32 = 16;
+/// Rays per side of each source's grid for the incident power.
+pub const INCIDENT_GRID: u32 = 96;
+/// Polygons gathered before their escape rays are traced in parallel.
+const BATCH: usize = 4096;
+/// Ray origins sit this far off the surface, relative to the scene's diagonal.
+const OFFSET_REL: f64 = 1e-7;
+
+/// Passes polygons on to `inner` and measures the balance's terms (see the module docs).
+pub struct DaylightBalance<S> {
+    inner: S,
+    caster: Option<InstanceCaster>,
+    sources: Vec<DistantSource>,
+    bounds: Aabb,
+    /// `1 − ρ − t` per material and channel.
+    absorptance: Vec<[f64; 3]>,
+    batch: Vec<(u64, Vec<(Poly, [f64; 3])>)>,
+    escaped: [f64; 3],
+    absorbed: [f64; 3],
+    emitted: [f64; 3],
+    /// Emission per material.
+    emission: Vec<[f64; 3]>,
+}
+
+/// The terms of the balance, per channel (W).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PowerBalance {
+    /// Delivered to the surfaces by the sun and sky.
+    pub incident: [f64; 3],
+    /// Absorbed by the surfaces.
+    pub absorbed: [f64; 3],
+    /// Leaving the scene.
+    pub escaped: [f64; 3],
+    /// Emitted by the polygons.
+    pub emitted: [f64; 3],
+}
+
+impl PowerBalance {
+    /// `(absorbed + escaped) / (incident + emitted)` of channel `c` (`None` when nothing comes
+    /// in).
+    #[must_use]
+    pub fn ratio(&self, c: usize) -> Option<f64> {
+        let inp = self.incident[c] + self.emitted[c];
+        (inp > 0.0).then(|| (self.absorbed[c] + self.escaped[c]) / inp)
+    }
+}
+
+impl<S: RadiositySink> DaylightBalance<S> {
+    /// Measures the balance of `scene` under `sources` while passing polygons on to `inner`.
+    pub fn new(inner: S, scene: &InstancedScene, sources: &[DistantSource]) -> DaylightBalance<S> {
+        // The nested BVHs only when there is something to trace.
+        let caster = (!sources.is_empty()).then(|| InstanceCaster::new(scene));
+        let bounds = scene.local_bounds().get(scene.root as usize).copied().unwrap_or(Aabb::EMPTY);
+        DaylightBalance {
+            inner,
+            caster,
+            sources: sources.to_vec(),
+            bounds,
+            absorptance: scene.materials.iter().map(|m| std::array::from_fn(|c| 1.0 - m.reflectance[c] - m.transmittance[c])).collect(),
+            batch: Vec::new(),
+            escaped: [0.0; 3],
+            absorbed: [0.0; 3],
+            emitted: [0.0; 3],
+            emission: scene.materials.iter().map(|m| m.emission).collect(),
+        }
+    }
+
+    fn diagonal(&self) -> f64 {
+        if self.bounds.is_empty() { 0.0 } else { (self.bounds.max - self.bounds.min).length() }
+    }
+
+    /// Traces the gathered polygons' escape rays; sums in arrival order.
+    fn flush(&mut self) {
+        let diag = self.diagonal();
+        let (Some(caster), batch) = (&self.caster, &self.batch) else { return };
+        let out: Vec<[f64; 3]> = batch.par_iter().map(|(index, leaves)| escaped(caster, *index, leaves, diag)).collect();
+        for e in out {
+            for c in 0..3 {
+                self.escaped[c] += e[c];
+            }
+        }
+        self.batch.clear();
+    }
+
+    /// Finishes the escape rays, traces the incident power, and gives back the sink with the
+    /// balance (`None` without distant sources).
+    pub fn finish(mut self) -> (S, Option<PowerBalance>) {
+        self.flush();
+        let Some(caster) = &self.caster else { return (self.inner, None) };
+        let incident = incident(caster, &self.sources, &self.bounds);
+        (self.inner, Some(PowerBalance { incident, absorbed: self.absorbed, escaped: self.escaped, emitted: self.emitted }))
+    }
+}
+
+/// The power leaving polygon `index` (leaves with their radiosity) for good.
+fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], diag: f64) -> [f64; 3] {
+    let areas: Vec<f64> = leaves.iter().map(|(p, _)| p.area()).collect();
+    let total: f64 = areas.iter().sum();
+    if !(total > 0.0) || leaves.iter().all(|(_, b)| b.iter().all(|&v| v <= 0.0)) {
+        return [0.0; 3];
+    }
+    let mut rng = crate::visibility::Rng::for_link(0x0e5c_a9ed, (index >> 32) as u32, index as u32);
+    let (offset, far) = (OFFSET_REL * diag.max(f64::MIN_POSITIVE), crate::daylight::FAR_REL * diag);
+    let mut out = [0.0; 3];
+    let step = total / f64::from(ESCAPE_RAYS);
+    let (mut k, mut cum) = (0usize, areas[0]);
+    for j in 0..ESCAPE_RAYS {
+        // Stratified over the leaves by area.
+        let target = (f64::from(j) + rng.next_f64()) * step;
+        while target > cum && k + 1 < leaves.len() {
+            k += 1;
+            cum += areas[k];
+        }
+        let (poly, b) = &leaves[k];
+        let n = poly.normal();
+        let x = poly.sample(rng.next_f64(), rng.next_f64()) + n * offset;
+        // Cosine-distributed about n.
+        let (u1, u2) = (rng.next_f64(), rng.next_f64());
+        let (r, phi) = (u1.sqrt(), std::f64::consts::TAU * u2);
+        let t = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+        let e1 = n.cross(t).normalize();
+        let e2 = n.cross(e1);
+        let d = e1 * (r * phi.cos()) + e2 * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
+        if caster.segment_clear(x, x + d * far) {
+            for c in 0..3 {
+                out[c] += b[c] * step;
+            }
+        }
+    }
+    out
+}
+
+/// The power the sources deliver to the surfaces (see the module docs).
+fn incident(caster: &InstanceCaster, sources: &[DistantSource], bounds: &Aabb) -> [f64; 3] {
+    if bounds.is_empty() {
+        return [0.0; 3];
+    }
+    let diag = (bounds.max - bounds.min).length();
+    let centre = (bounds.min + bounds.max) * 0.5;
+    let per_source: Vec<[f64; 3]> = sources
+        .par_iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let d = -s.toward.normalize();
+            let t = if d.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+            let (e1, e2) = (d.cross(t).normalize(), d.cross(d.cross(t).normalize()));
+            let (mut u0, mut u1, mut v0, mut v1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..8 {
+                let c = super::model::corner(bounds, i) - centre;
+                (u0, u1) = (u0.min(c.dot(e1)), u1.max(c.dot(e1)));
+                (v0, v1) = (v0.min(c.dot(e2)), v1.max(c.dot(e2)));
+            }
+            let g = INCIDENT_GRID;
+            let (du, dv) = ((u1 - u0) / f64::from(g), (v1 - v0) / f64::from(g));
+            let mut rng = crate::visibility::Rng::for_link(0x1c1d_e47, k as u32, g);
+            let mut hits = 0u64;
+            for i in 0..g {
+                for j in 0..g {
+                    let u = u0 + (f64::from(i) + rng.next_f64()) * du;
+                    let v = v0 + (f64::from(j) + rng.next_f64()) * dv;
+                    let p = centre + e1 * u + e2 * v;
+                    if !caster.segment_clear(p + d * diag, p - d * diag) {
+                        hits += 1;
+                    }
+                }
+            }
+            let area = hits as f64 * du * dv;
+            s.irradiance.map(|e| e * area)
+        })
+        .collect();
+    per_source.iter().fold([0.0; 3], |a, b| std::array::from_fn(|c| a[c] + b[c]))
+}
+
+impl<S: RadiositySink> RadiositySink for DaylightBalance<S> {
+    fn polygon(&mut self, info: &PolygonInfo, leaves: &[Leaf]) -> Result<(), InstancingError> {
+        if !self.sources.is_empty() {
+            let alpha = self.absorptance.get(info.material as usize).copied().unwrap_or([0.0; 3]);
+            let emission = self.emission.get(info.material as usize).copied().unwrap_or([0.0; 3]);
+            for leaf in leaves {
+                let a = leaf.poly.area();
+                for c in 0..3 {
+                    self.absorbed[c] += a * alpha[c] * leaf.h[c];
+                    self.emitted[c] += a * emission[c];
+                }
+            }
+            self.batch.push((info.flat_index, leaves.iter().map(|l| (l.poly, l.b)).collect()));
+            if self.batch.len() >= BATCH {
+                self.flush();
+            }
+        }
+        self.inner.polygon(info, leaves)
+    }
+}
