@@ -51,7 +51,8 @@ pub const SKY_RAYS_DIVISOR: u32 = 16;
 /// A sky of more cells than this (facing a polygon's sides) is not traced cell by cell but by
 /// `SKY_MAX_CELLS·⌈N / `[`SKY_RAYS_DIVISOR`]`⌉` rays drawn over its cells in proportion to their
 /// light (see the module docs): a 46-cell sky is traced cell by cell, a 145-cell one at the cost
-/// of 48 cells. Measured on a 9-tree forest (1.2 M polygons): ... .
+/// of 48 cells. Exact when nothing blocks; within 5% of the cell-by-cell sum on a polygon that
+/// sees half the sky (the unit test `sampled_sky_is_exact_unoccluded_and_close_half_blocked`).
 pub const SKY_MAX_CELLS: u32 = 48;
 
 /// Most points of a top-level polygon (see the module docs).

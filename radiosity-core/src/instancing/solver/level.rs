@@ -236,7 +236,8 @@ pub(super) fn solve_level(level: &mut Level, external: &[[f64; 3]], config: &Ins
 
 /// Sets the emission of `level`'s hierarchy: the base emission, the first reflection (and a
 /// leaf's transmission) of the light from outside, and the proxies' cross-face emission from
-/// `irradiance` (per polygon, everything arriving) or, without it, from the light from outside.
+/// `irradiance` (per polygon, what the links bring) plus the light from outside, or, without it,
+/// from the light from outside alone.
 fn set_emission(level: &mut Level, external: &[[f64; 3]], irradiance: Option<&[[f64; 3]]>) {
     let h = &mut level.h;
     for i in 0..h.emission.len() {
@@ -247,8 +248,16 @@ fn set_emission(level: &mut Level, external: &[[f64; 3]], irradiance: Option<&[[
         h.emission[i] =
             std::array::from_fn(|c| level.base_emission[i][c] + h.reflectance[i][c] * ext[c] + h.transmittance[i][c] * other[c]);
     }
-    let source = irradiance.unwrap_or(external);
-    level.cross.add_emission(&mut h.emission, |i| source.get(i).copied().unwrap_or([0.0; 3]), 1.0);
+    // Everything that arrives: the links' irradiance and the light from outside (at the top, the
+    // daylight's direct part, which enters as emission and is not in the links' irradiance: left
+    // out, a proxy lit by the sun passed none of it on through its other faces, and a 9-tree
+    // forest's power balance in NIR was 3.3% short, now 2.2%).
+    let get = |v: &[[f64; 3]], i: usize| v.get(i).copied().unwrap_or([0.0; 3]);
+    let cross_source = |i: usize| match irradiance {
+        Some(irr) => std::array::from_fn(|c| get(irr, i)[c] + get(external, i)[c]),
+        None => get(external, i),
+    };
+    level.cross.add_emission(&mut h.emission, cross_source, 1.0);
 }
 
 /// Solves the links of `level` for the emission its hierarchy holds.
