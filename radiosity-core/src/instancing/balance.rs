@@ -40,13 +40,17 @@ pub struct DaylightBalance<S> {
     bounds: Aabb,
     /// `1 − ρ − t` per material and channel.
     absorptance: Vec<[f64; 3]>,
-    batch: Vec<(u64, Vec<(Poly, [f64; 3])>)>,
+    batch: Vec<Finished>,
     escaped: [f64; 3],
     absorbed: [f64; 3],
     emitted: [f64; 3],
     /// Emission per material.
     emission: Vec<[f64; 3]>,
 }
+
+/// A finished polygon awaiting its escape rays: its flattened index, its leaves with their
+/// radiosity.
+type Finished = (u64, Vec<(Poly, [f64; 3])>);
 
 /// The terms of the balance, per channel (W).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -101,8 +105,8 @@ impl<S: RadiositySink> DaylightBalance<S> {
         let (Some(caster), batch) = (&self.caster, &self.batch) else { return };
         let out: Vec<[f64; 3]> = batch.par_iter().map(|(index, leaves)| escaped(caster, *index, leaves, diag)).collect();
         for e in out {
-            for c in 0..3 {
-                self.escaped[c] += e[c];
+            for (sum, v) in self.escaped.iter_mut().zip(e) {
+                *sum += v;
             }
         }
         self.batch.clear();
@@ -122,7 +126,7 @@ impl<S: RadiositySink> DaylightBalance<S> {
 fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], diag: f64) -> [f64; 3] {
     let areas: Vec<f64> = leaves.iter().map(|(p, _)| p.area()).collect();
     let total: f64 = areas.iter().sum();
-    if !(total > 0.0) || leaves.iter().all(|(_, b)| b.iter().all(|&v| v <= 0.0)) {
+    if total.is_nan() || total <= 0.0 || leaves.iter().all(|(_, b)| b.iter().all(|&v| v <= 0.0)) {
         return [0.0; 3];
     }
     let mut rng = crate::visibility::Rng::for_link(0x0e5c_a9ed, (index >> 32) as u32, index as u32);
@@ -178,7 +182,7 @@ fn incident(caster: &InstanceCaster, sources: &[DistantSource], bounds: &Aabb) -
             }
             let g = INCIDENT_GRID;
             let (du, dv) = ((u1 - u0) / f64::from(g), (v1 - v0) / f64::from(g));
-            let mut rng = crate::visibility::Rng::for_link(0x1c1d_e47, k as u32, g);
+            let mut rng = crate::visibility::Rng::for_link(0x01c1_de47, k as u32, g);
             let mut hits = 0u64;
             for i in 0..g {
                 for j in 0..g {

@@ -380,8 +380,8 @@ impl RadiositySink for StreamedOutput {
         let absorbed: [f64; 3] = std::array::from_fn(|c| area * alpha[c] * h[c]);
         if let Some(g) = self.groups.get_mut(info.prototype as usize) {
             g.0 += area;
-            for c in 0..3 {
-                g.1[c] += absorbed[c];
+            for (sum, v) in g.1.iter_mut().zip(absorbed) {
+                *sum += v;
             }
         }
         let nb = self.bands.len();
