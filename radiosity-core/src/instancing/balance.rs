@@ -7,8 +7,10 @@
 //!   scene's box as seen along the beam; each ray that meets a polygon (through the nested BVHs,
 //!   [`InstanceCaster`]) carries `E` times its cell's area.
 //! - **Escaped**: what leaves the surfaces for good, from the radiosity the solve streams out.
-//!   For each finished polygon, [`ESCAPE_RAYS`] points over its leaves (by area) each send one
-//!   cosine-distributed ray; those that meet nothing carry `B·A/N` of their leaf's radiosity out.
+//!   For each finished polygon, [`ESCAPE_RAYS`] points over its leaves (by area; more on a polygon
+//!   larger than [`ESCAPE_AREA_REL`] of the scene's diagonal squared, in proportion to its area,
+//!   up to [`ESCAPE_MAX_RAYS`]) each send one cosine-distributed ray; those that meet nothing
+//!   carry `B·A/N` of their leaf's radiosity out.
 //!   Seeded by the polygon's flattened index: the same figure whatever order polygons arrive in.
 //! - **Absorbed**: `A·(1 − ρ − t)·H` summed over the polygons (as `patches.csv` has it).
 //!
@@ -25,6 +27,12 @@ use rayon::prelude::*;
 
 /// Rays per polygon for the escaped power.
 pub const ESCAPE_RAYS: u32 = 16;
+/// Area, relative to the scene's diagonal squared, above which a polygon gets more escape rays
+/// (see the module docs). With 16 rays, a forest's ground (one polygon, most of the light that
+/// leaves) had its escape fraction in steps of 1/16: the 9-tree forest's NIR balance read 0.979.
+pub const ESCAPE_AREA_REL: f64 = 1.0 / 4096.0;
+/// Most escape rays of one polygon.
+pub const ESCAPE_MAX_RAYS: u32 = 4096;
 /// Rays per side of each source's grid for the incident power.
 pub const INCIDENT_GRID: u32 = 96;
 /// Polygons gathered before their escape rays are traced in parallel.
@@ -132,9 +140,15 @@ fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], dia
     let mut rng = crate::visibility::Rng::for_link(0x0e5c_a9ed, (index >> 32) as u32, index as u32);
     let (offset, far) = (OFFSET_REL * diag.max(f64::MIN_POSITIVE), crate::daylight::FAR_REL * diag);
     let mut out = [0.0; 3];
-    let step = total / f64::from(ESCAPE_RAYS);
+    let reference = ESCAPE_AREA_REL * diag * diag;
+    let rays = if reference > 0.0 {
+        (f64::from(ESCAPE_RAYS) * total / reference).ceil().clamp(f64::from(ESCAPE_RAYS), f64::from(ESCAPE_MAX_RAYS)) as u32
+    } else {
+        ESCAPE_RAYS
+    };
+    let step = total / f64::from(rays);
     let (mut k, mut cum) = (0usize, areas[0]);
-    for j in 0..ESCAPE_RAYS {
+    for j in 0..rays {
         // Stratified over the leaves by area.
         let target = (f64::from(j) + rng.next_f64()) * step;
         while target > cum && k + 1 < leaves.len() {
