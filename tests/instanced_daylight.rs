@@ -307,6 +307,15 @@ fn cli_instanced_bands_report_absorbed_power() {
     }
     // The black ground absorbs what reaches it: more than the cube and quad together.
     assert!(total[0] > 100.0 * 50.0, "PAR absorbed {}", total[0]);
+    // The balance: the incident power is the 10 × 10 ground's E·A, give or take what the cube and
+    // the quad catch beyond their shadows (0.13% measured); absorbed and escaped add up to it.
+    for (c, band) in ["PAR", "NIR"].into_iter().enumerate() {
+        let p = &stats["power_by_band"][band];
+        let incident = p["incident"].as_f64().unwrap();
+        assert!((incident / (100.0 * e[c]) - 1.0).abs() < 0.005, "{band}: incident {incident} vs {}", 100.0 * e[c]);
+        let balance = (p["absorbed"].as_f64().unwrap() + p["escaped"].as_f64().unwrap()) / incident;
+        assert!((balance - 1.0).abs() < INSTANCED_BALANCE_TOL, "{band}: balance {balance}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
