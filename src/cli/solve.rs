@@ -169,6 +169,14 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         let flat_daylight = lighting.bands.has_daylight() && scene.prototypes[scene.root as usize].instances.is_empty();
         if lighting.needs_plain_solve() || flat_daylight || !scene.grids.is_empty() || has_grids {
             anyhow::ensure!(args.instances == Instances::None, "--instances auto applies to plain OBJ / MGF scenes");
+            let instanced = !scene.prototypes[scene.root as usize].instances.is_empty();
+            if instanced && lighting.bands.packs() > 1 && !args.quiet {
+                eprintln!(
+                    "note: {} bands: the scene is flattened and solved plain, one solve per three bands \
+                     (up to three bands solve instanced, which on plants is much faster)",
+                    lighting.bands.len()
+                );
+            }
             let mut plain = radiosity::instancing::flatten(&scene, &radiosity::instancing::FlattenOptions::default())?;
             plain.luminaires = lighting.luminaires;
             plain.units = lighting.units;
