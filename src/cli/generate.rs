@@ -118,6 +118,10 @@ pub struct DaylightArgs {
     /// Sky cells (46 or 145 like the turtle skies, or any count).
     #[arg(long, default_value_t = 145, requires = "daylight")]
     sky_directions: u32,
+    /// Largest side of the ground's tiles (m): the instanced solve lights each top-level polygon
+    /// by its mean, so the ground is split for the trees' shadows to show on it.
+    #[arg(long, default_value_t = 0.5, requires = "daylight")]
+    ground_tile: f64,
 }
 
 /// Optical properties per band (PAR, NIR) of the generated materials: reflectance, transmittance.
@@ -230,6 +234,16 @@ pub fn run(cmd: GenerateCommand) -> anyhow::Result<()> {
         let light = scene.materials.iter().position(|m| m.name == instancing::plant::LIGHT).map(|i| i as u32);
         for p in &mut scene.prototypes {
             p.polygons.retain(|q| Some(q.material) != light);
+        }
+        // The ground in tiles: the instanced solve lights a top-level polygon by its mean.
+        anyhow::ensure!(
+            daylight.ground_tile > 0.0 && daylight.ground_tile.is_finite(),
+            "--ground-tile must be a positive length, got {}",
+            daylight.ground_tile
+        );
+        if let Some(g) = scene.materials.iter().position(|m| m.name == instancing::plant::GROUND) {
+            let root = scene.root;
+            instancing::plant::tile_quads(&mut scene, root, g as u32, daylight.ground_tile);
         }
     }
     let path = instancing::write_scene(&scene, &out, stem)?;
