@@ -319,6 +319,48 @@ fn cli_instanced_bands_report_absorbed_power() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The plant scientist's two commands: `generate tree --daylight` and `solve` give absorbed PAR
+/// and NIR per leaf side and per prototype, with the balance closed; a bad `--ground-tile` is one
+/// line.
+#[test]
+fn generated_tree_under_daylight_reports_absorbed_par_and_nir() {
+    let dir = std::env::temp_dir().join(format!("radiosity-generated-daylight-{}", std::process::id()));
+    let bin = env!("CARGO_BIN_EXE_radiosity");
+    let run = |args: &[&str]| Command::new(bin).args(args).output().expect("the binary runs");
+    let tree = dir.join("tree");
+    let g = run(&["generate", "tree", "--age", "3", "--daylight", "-o", tree.to_str().unwrap()]);
+    assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
+    let out = dir.join("out");
+    let s = run(&["solve", tree.join("tree.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"]);
+    assert!(s.status.success(), "{}", String::from_utf8_lossy(&s.stderr));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["bands"], serde_json::json!(["PAR", "NIR"]));
+    assert!(stats["local_solves"].as_u64().unwrap() > 1, "solved instanced");
+    for band in ["PAR", "NIR"] {
+        let p = &stats["power_by_band"][band];
+        let balance = (p["absorbed"].as_f64().unwrap() + p["escaped"].as_f64().unwrap()) / p["incident"].as_f64().unwrap();
+        assert!((balance - 1.0).abs() < INSTANCED_BALANCE_TOL, "{band}: balance {balance}");
+    }
+    let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    let header: Vec<&str> = patches.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let (mat, par, nir) = (col("material"), col("absorbed_PAR"), col("absorbed_NIR"));
+    let leaves: Vec<Vec<&str>> = patches.lines().skip(1).map(|l| l.split(',').collect::<Vec<_>>()).filter(|r| r[mat] == "leaf").collect();
+    assert!(leaves.len() > 100 && leaves.len() % 2 == 0, "{} leaf sides", leaves.len());
+    // Leaves absorb most of the PAR and scatter most of the NIR that reaches them.
+    let sum = |k: usize| leaves.iter().map(|r| r[k].parse::<f64>().unwrap()).sum::<f64>();
+    assert!(sum(par) > 2.0 * sum(nir), "leaves absorbed PAR {} NIR {}", sum(par), sum(nir));
+    let groups = std::fs::read_to_string(out.join("groups.csv")).unwrap();
+    assert!(groups.starts_with("group,area,absorbed_PAR,absorbed_NIR\n") && groups.lines().count() > 3, "{groups}");
+    // The ground came in tiles of at most 0.5 m.
+    let grounds = patches.lines().skip(1).filter(|l| l.split(',').nth(mat) == Some("ground")).count();
+    assert!(grounds >= 16, "{grounds} ground tiles");
+    let bad = run(&["generate", "tree", "--age", "3", "--daylight", "--ground-tile", "0", "-o", tree.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success() && err.trim().lines().count() == 1 && err.contains("--ground-tile"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Where the instanced solve departs from the flattened one, by material and side (run by hand).
 #[test]
 #[ignore = "diagnostic"]
