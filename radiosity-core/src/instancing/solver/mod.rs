@@ -83,6 +83,7 @@ mod outside;
 mod proxy;
 mod reference;
 mod sink;
+mod sky_sample;
 mod task;
 
 pub use cache::SIMILARITY_TOLERANCE;
