@@ -64,9 +64,13 @@ pub struct PropertyConfig {
     pub method: PhaseMethod,
 }
 
+/// 32 directions of 8,192 rays (8,281 after rounding to strata; 1,024 until 2026-12-02): the face
+/// transfer matrix splits each direction's light over six faces and needs the rays. The 9-tree
+/// daylight forest's NIR power balance went from 0.9909 to 0.9936 in the same 33 s; the age-30
+/// tree's errors against the full solve stayed 2.83% / 0.052% (directional proxies).
 impl Default for PropertyConfig {
     fn default() -> Self {
-        PropertyConfig { n_directions: 32, rays_per_direction: 1024, seed: 1, method: PhaseMethod::RandomWalk }
+        PropertyConfig { n_directions: 32, rays_per_direction: 8192, seed: 1, method: PhaseMethod::RandomWalk }
     }
 }
 
