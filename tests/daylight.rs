@@ -180,7 +180,10 @@ fn four_bands_are_two_solves_that_agree_with_one() {
 fn bad_daylight_input_is_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
     let cases: [(&str, &str); 6] = [
-        ("bands = [\"PAR\", \"NIR\"]\n[[material]]\nname = \"m\"\nreflectance = [0.1, 0.2, 0.3]\n", "3 values given, the scene has 2 bands"),
+        (
+            "bands = [\"PAR\", \"NIR\"]\n[[material]]\nname = \"m\"\nreflectance = [0.1, 0.2, 0.3]\n",
+            "3 values given, the scene has 2 bands",
+        ),
         ("bands = [\"PAR\", \"PAR\"]\n", "duplicate band `PAR`"),
         ("bands = [\"PAR\"]\n[[material]]\nname = \"m\"\nreflectance = 0.6\ntransmittance = 0.5\n", "sum below 1"),
         ("[sun]\ndirect_normal = 100\n", "give either `direction`, or `latitude`, `longitude` and `time`"),

@@ -248,7 +248,8 @@ fn cli_instanced_bands_report_absorbed_power() {
     let dir = std::env::temp_dir().join(format!("radiosity-instanced-bands-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let scene_path = dir.join("scene.toml");
-    let geometry = OPEN_SKY.replace("reflectance = 0.5", "reflectance = [0.2, 0.6]").replace("reflectance = 0.0", "reflectance = [0.0, 0.0]");
+    let geometry =
+        OPEN_SKY.replace("reflectance = 0.5", "reflectance = [0.2, 0.6]").replace("reflectance = 0.0", "reflectance = [0.0, 0.0]");
     let text = format!(
         "bands = [\"PAR\", \"NIR\"]\n{geometry}\n[sun]\ndirection = [0.3, 0.2, -0.93]\ndirect_normal = [400.0, 380.0]\n[sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = [100.0, 90.0]\ndirections = 46\n"
     );

@@ -103,9 +103,7 @@ pub fn sun_position(latitude: f64, longitude: f64, time: &str) -> Result<(f64, f
     let t = chrono::DateTime::parse_from_rfc3339(time)
         .map_err(|e| DaylightError(format!("time `{time}` is not RFC 3339 ({e}), e.g. 2026-06-21T12:00:00+02:00")))?;
     if !(-90.0..=90.0).contains(&latitude) || !(-180.0..=180.0).contains(&longitude) {
-        return Err(DaylightError(format!(
-            "latitude {latitude} / longitude {longitude} out of range (-90..90, -180..180 degrees)"
-        )));
+        return Err(DaylightError(format!("latitude {latitude} / longitude {longitude} out of range (-90..90, -180..180 degrees)")));
     }
     let pos = spa::solar_position::<spa::StdFloatOps>(t.with_timezone(&chrono::Utc), latitude, longitude)
         .map_err(|e| DaylightError(format!("solar position: {e:?}")))?;
@@ -212,8 +210,7 @@ pub fn sky_cells(n: u32) -> Result<Vec<SkyCell>, DaylightError> {
 pub fn sky(model: SkyModel, diffuse_horizontal: [f64; 3], n: u32, site: &Site) -> Result<Vec<DistantSource>, DaylightError> {
     check_levels("diffuse_horizontal", &diffuse_horizontal)?;
     let cells = sky_cells(n)?;
-    let weights: Vec<f64> =
-        cells.iter().map(|c| c.phi_width * (model.moment(c.mu_high, 1) - model.moment(c.mu_low, 1))).collect();
+    let weights: Vec<f64> = cells.iter().map(|c| c.phi_width * (model.moment(c.mu_high, 1) - model.moment(c.mu_low, 1))).collect();
     let total: f64 = weights.iter().sum();
     Ok(cells
         .iter()
@@ -394,7 +391,8 @@ pub fn balance_gap(h: &crate::hierarchy::Hierarchy, solution: &crate::solve::Sol
         let p = p as usize;
         let direct = h.direct.get(leaf as usize).copied().unwrap_or_default();
         for c in 0..3 {
-            absorbed[c] += e.area * (1.0 - h.reflectance[p][c] - h.transmittance[p][c]) * (solution.irradiance[leaf as usize][c] + direct[c]);
+            absorbed[c] +=
+                e.area * (1.0 - h.reflectance[p][c] - h.transmittance[p][c]) * (solution.irradiance[leaf as usize][c] + direct[c]);
             emitted[c] += e.area * h.emission[p][c];
         }
     }

@@ -330,11 +330,15 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     if let Some(b) = declared {
         let packs: Vec<&[output::PolygonResult]> = pack_results.iter().map(Vec::as_slice).collect();
         for (name, write) in [
-            ("patches.csv", output::write_patches_csv_bands as fn(&mut output::atomic::AtomicFile, &_, &[String], &[&[output::PolygonResult]]) -> _),
+            (
+                "patches.csv",
+                output::write_patches_csv_bands as fn(&mut output::atomic::AtomicFile, &_, &[String], &[&[output::PolygonResult]]) -> _,
+            ),
             ("groups.csv", output::write_groups_csv_bands),
         ] {
             let path = args.out.join(name);
-            output::atomic::write_file(&path, |w| write(w, &scene, &b.names, &packs)).with_context(|| format!("{}: cannot write", path.display()))?;
+            output::atomic::write_file(&path, |w| write(w, &scene, &b.names, &packs))
+                .with_context(|| format!("{}: cannot write", path.display()))?;
         }
     }
     if let Some((points, results, seconds)) = &gathered {
@@ -433,7 +437,10 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
                 }
             }
         }
-        _ => println!("power: emitted {:.6e} {unit}, absorbed {:.6e} {unit} (balance {:.5}; {closed})", s.power_emitted, s.power_absorbed, balance),
+        _ => println!(
+            "power: emitted {:.6e} {unit}, absorbed {:.6e} {unit} (balance {:.5}; {closed})",
+            s.power_emitted, s.power_absorbed, balance
+        ),
     }
     if let Some(sun) = &s.sun {
         let az = sun.azimuth_deg.map_or(String::new(), |a| format!(", azimuth {a:.2} deg from north"));
@@ -527,7 +534,11 @@ fn solve_instanced(
         }
     }
     let total = scene.flattened_counts(true).get(scene.root as usize).copied().unwrap_or(0);
-    let output = if bands.declared { StreamedOutput::with_bands(&args.out, scene, &bands.names)? } else { StreamedOutput::create(&args.out, scene)? };
+    let output = if bands.declared {
+        StreamedOutput::with_bands(&args.out, scene, &bands.names)?
+    } else {
+        StreamedOutput::create(&args.out, scene)?
+    };
     // Under the sun and sky, the power balance is measured beside the output.
     let output = radiosity::instancing::balance::DaylightBalance::new(output, scene, &config.daylight);
     let mut sink = Progressing { inner: output, done: 0, total, reporter: Reporter::new(args.quiet) };
@@ -566,7 +577,8 @@ fn solve_instanced(
             .iter()
             .enumerate()
             .map(|(c, n)| {
-                let band = output::BandPower { emitted: b.emitted[c], incident: b.incident[c], absorbed: b.absorbed[c], escaped: b.escaped[c] };
+                let band =
+                    output::BandPower { emitted: b.emitted[c], incident: b.incident[c], absorbed: b.absorbed[c], escaped: b.escaped[c] };
                 (n.clone(), serde_json::to_value(band).expect("plain numbers"))
             })
             .collect();

@@ -231,13 +231,19 @@ pub(super) fn resolve(input: &BandsInput<'_>, path: &Path, line: usize) -> Resul
                 ));
             }
             if !(m.emission[b] >= 0.0 && m.emission[b].is_finite()) {
-                return Err(InstancingError::at(path, *line, format!("band `{}`: emission {} must be finite and non-negative", names[b], m.emission[b])));
+                return Err(InstancingError::at(
+                    path,
+                    *line,
+                    format!("band `{}`: emission {} must be finite and non-negative", names[b], m.emission[b]),
+                ));
             }
         }
         materials.push(m);
     }
     let site = match input.site {
-        Some(s) => Site::new(DVec3::from(s.up), DVec3::from(s.north)).map_err(|e| InstancingError::at(path, line, format!("[site]: {e}")))?,
+        Some(s) => {
+            Site::new(DVec3::from(s.up), DVec3::from(s.north)).map_err(|e| InstancingError::at(path, line, format!("[site]: {e}")))?
+        }
         None => Site::default(),
     };
     let (mut sun, mut sun_report) = (None, None);

@@ -63,8 +63,8 @@ pub mod balance;
 pub mod bands;
 pub mod bench;
 pub mod caster;
-pub mod face_transfer;
 mod error;
+pub mod face_transfer;
 pub mod flatten;
 pub mod format;
 pub mod model;
@@ -85,7 +85,7 @@ pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, 
 pub use output::{StreamedOutput, StreamedSummary};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};
 pub use solver::{
-    InstanceLevels, InstancedConfig, InstancedStats, Leaf, LevelReuse, PolygonInfo, PolygonMeans, ProxyEmission, RadiositySink, distributed, solve_full,
-    solve_instanced,
+    InstanceLevels, InstancedConfig, InstancedStats, Leaf, LevelReuse, PolygonInfo, PolygonMeans, ProxyEmission, RadiositySink,
+    distributed, solve_full, solve_instanced,
 };
 pub use write::write_scene;

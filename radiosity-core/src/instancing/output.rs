@@ -118,11 +118,7 @@ impl StreamedOutput {
             max_b: 0.0,
             grey: bands.iter().map(String::as_str).ne(["r", "g", "b"]),
             bands,
-            absorptance: scene
-                .materials
-                .iter()
-                .map(|m| std::array::from_fn(|c| 1.0 - m.reflectance[c] - m.transmittance[c]))
-                .collect(),
+            absorptance: scene.materials.iter().map(|m| std::array::from_fn(|c| 1.0 - m.reflectance[c] - m.transmittance[c])).collect(),
             groups: vec![(0.0, [0.0; 3]); scene.prototypes.len()],
         })
     }

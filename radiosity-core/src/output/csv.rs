@@ -61,7 +61,12 @@ pub fn write_groups_csv(w: &mut impl Write, scene: &Scene, results: &[PolygonRes
 
 /// [`write_groups_csv`] for named bands: `packs[k]` holds the results of bands `3k .. 3k + 3`
 /// (see [`crate::instancing::bands`]); one `absorbed_<band>` column per name.
-pub fn write_groups_csv_bands(w: &mut impl Write, scene: &Scene, names: &[impl AsRef<str>], packs: &[&[PolygonResult]]) -> std::io::Result<()> {
+pub fn write_groups_csv_bands(
+    w: &mut impl Write,
+    scene: &Scene,
+    names: &[impl AsRef<str>],
+    packs: &[&[PolygonResult]],
+) -> std::io::Result<()> {
     let nb = names.len();
     let mut sums = vec![(0usize, 0.0, vec![0.0; nb]); scene.groups.len()];
     for (i, p) in scene.polygons.iter().enumerate() {
@@ -96,7 +101,12 @@ pub fn write_patches_csv(w: &mut impl Write, scene: &Scene, results: &[PolygonRe
 
 /// [`write_patches_csv`] for named bands: `b_<band>` for every band, then `h_<band>`, `units`,
 /// `absorbed_<band>`; `packs[k]` holds the results of bands `3k .. 3k + 3`.
-pub fn write_patches_csv_bands(w: &mut impl Write, scene: &Scene, names: &[impl AsRef<str>], packs: &[&[PolygonResult]]) -> std::io::Result<()> {
+pub fn write_patches_csv_bands(
+    w: &mut impl Write,
+    scene: &Scene,
+    names: &[impl AsRef<str>],
+    packs: &[&[PolygonResult]],
+) -> std::io::Result<()> {
     write!(w, "index,group,material,area")?;
     for prefix in ["b", "h"] {
         for n in names {

@@ -16,7 +16,9 @@ mod stats;
 mod view;
 mod write;
 
-pub use csv::{PolygonResult, csv_field, polygon_results, write_groups_csv, write_groups_csv_bands, write_patches_csv, write_patches_csv_bands};
+pub use csv::{
+    PolygonResult, csv_field, polygon_results, write_groups_csv, write_groups_csv_bands, write_patches_csv, write_patches_csv_bands,
+};
 pub use falsecolor::{
     BACKGROUND, ColourScale, DEFAULT_LOG_DECADES, DEFAULT_MAX_AREA_SHARE, FalseColourConfig, LEGEND_MIN_HEIGHT, LEGEND_WIDTH, LINEAR_STEPS,
     PALETTE, Quantity, Scale, WATTS_PER_SQUARE_METRE, default_max, false_colour_image, format_label, nice_ceiling, palette,

@@ -144,7 +144,8 @@ impl BandPower {
     /// `(absorbed + escaped) / (emitted + incident)` with daylight, else `absorbed / emitted`.
     #[must_use]
     pub fn balance(&self, daylight: bool) -> Option<f64> {
-        let (out, inp) = if daylight { (self.absorbed + self.escaped, self.emitted + self.incident) } else { (self.absorbed, self.emitted) };
+        let (out, inp) =
+            if daylight { (self.absorbed + self.escaped, self.emitted + self.incident) } else { (self.absorbed, self.emitted) };
         (inp > 0.0).then(|| out / inp)
     }
 
