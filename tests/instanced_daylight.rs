@@ -216,6 +216,18 @@ fn unoccluded_polygons_get_e_cos_exactly() {
     assert_eq!(checked, 2);
 }
 
+/// Runs `radiosity solve scene` into `dir/out` (no image, quiet), which it returns; the solve
+/// must succeed.
+fn solve_cli(scene: &Path, dir: &Path) -> std::path::PathBuf {
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["solve", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"])
+        .output()
+        .expect("the binary runs");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    out
+}
+
 /// `radiosity solve` of an instanced scene file with `[sun]` and `[sky]` solves it instanced
 /// (not flattened) and writes the streamed outputs.
 #[test]
@@ -227,12 +239,7 @@ fn cli_solves_an_instanced_scene_under_daylight() {
         "{OPEN_SKY}\n[sun]\ndirection = [0.3, 0.2, -0.93]\ndirect_normal = 400.0\n[sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = 100.0\ndirections = 46\n"
     );
     std::fs::write(&scene, text).unwrap();
-    let out = dir.join("out");
-    let run = Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .args(["solve", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"])
-        .output()
-        .expect("the binary runs");
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let out = solve_cli(&scene, &dir);
     let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
     assert_eq!(stats["local_solves"], 2, "solved instanced: {stats}");
     let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
@@ -254,12 +261,7 @@ fn cli_instanced_bands_report_absorbed_power() {
         "bands = [\"PAR\", \"NIR\"]\n{geometry}\n[sun]\ndirection = [0.3, 0.2, -0.93]\ndirect_normal = [400.0, 380.0]\n[sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = [100.0, 90.0]\ndirections = 46\n"
     );
     std::fs::write(&scene_path, &text).unwrap();
-    let out = dir.join("out");
-    let run = Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .args(["solve", scene_path.to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"])
-        .output()
-        .expect("the binary runs");
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let out = solve_cli(&scene_path, &dir);
     let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
     let mut lines = patches.lines();
     assert_eq!(lines.next(), Some("index,group,material,area,b_PAR,b_NIR,h_PAR,h_NIR,units,absorbed_PAR,absorbed_NIR"));

@@ -22,7 +22,7 @@ use super::caster::InstanceCaster;
 use super::model::InstancedScene;
 use super::solver::{Leaf, PolygonInfo, RadiositySink};
 use crate::daylight::DistantSource;
-use crate::geom::{Aabb, DVec3, Poly};
+use crate::geom::{Aabb, Poly};
 use rayon::prelude::*;
 
 /// Rays per polygon for the escaped power.
@@ -158,13 +158,8 @@ fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], dia
         let (poly, b) = &leaves[k];
         let n = poly.normal();
         let x = poly.sample(rng.next_f64(), rng.next_f64()) + n * offset;
-        // Cosine-distributed about n.
         let (u1, u2) = (rng.next_f64(), rng.next_f64());
-        let (r, phi) = (u1.sqrt(), std::f64::consts::TAU * u2);
-        let t = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
-        let e1 = n.cross(t).normalize();
-        let e2 = n.cross(e1);
-        let d = e1 * (r * phi.cos()) + e2 * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
+        let d = super::properties::cosine_dir_from(n, u1, u2);
         if caster.segment_clear(x, x + d * far) {
             for c in 0..3 {
                 out[c] += b[c] * step;
@@ -186,8 +181,7 @@ fn incident(caster: &InstanceCaster, sources: &[DistantSource], bounds: &Aabb) -
         .enumerate()
         .map(|(k, s)| {
             let d = -s.toward.normalize();
-            let t = if d.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
-            let (e1, e2) = (d.cross(t).normalize(), d.cross(d.cross(t).normalize()));
+            let (e1, e2) = super::properties::basis(d);
             let (mut u0, mut u1, mut v0, mut v1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
             for i in 0..8 {
                 let c = super::model::corner(bounds, i) - centre;

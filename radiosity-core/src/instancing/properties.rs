@@ -312,7 +312,7 @@ pub fn compute_flat(flat: &Scene, name: &str, key: String, config: &PropertyConf
 }
 
 /// An orthonormal pair perpendicular to unit `d`.
-fn basis(d: DVec3) -> (DVec3, DVec3) {
+pub(super) fn basis(d: DVec3) -> (DVec3, DVec3) {
     let helper = if d.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
     let u = d.cross(helper).normalize();
     (u, d.cross(u))
