@@ -48,8 +48,13 @@ pub struct Config {
     /// when that would store more than `leaf_operator_max_entries` coefficients, one gather pass is
     /// done instead.
     pub final_gather: bool,
-    /// Budget of the leaf-resolution operator (coefficients, 12 bytes each).
+    /// Budget of the leaf-resolution operator's stored coefficients
+    /// ([`solve::LEAF_OPERATOR_ENTRY_BYTES`] each).
     pub leaf_operator_max_entries: usize,
+    /// Over that budget, store what fits and compute the rest again at every iteration (the same
+    /// answer, slower); off: do one gather pass instead of the leaf-resolution solve (an
+    /// approximation, what the instanced solver's local problems do to stay small).
+    pub stream_leaf_operator: bool,
     /// Estimate the solution's error ([`Solved::error_estimate`]).
     pub estimate_error: bool,
     /// Measure each element's radiosity variation after every solve ([`solve::element_data`]), for
@@ -84,6 +89,7 @@ impl Default for Config {
             visibility_method: VisibilityMethod::Rays,
             final_gather: true,
             leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
+            stream_leaf_operator: true,
             estimate_error: true,
             measure_variation: true,
             detect_closure: true,
@@ -161,6 +167,9 @@ pub struct Timings {
     pub refine: f64,
     /// Linear solves.
     pub solve: f64,
+    /// The error estimate (the solves on coarsened meshes, the visibility noise) and, with
+    /// daylight, the power balance measured per level.
+    pub estimate: f64,
 }
 
 /// Progress events for front ends.
@@ -179,8 +188,11 @@ pub enum Progress {
     },
     /// The leaf-resolution operator is being built with this many coefficients.
     LeafSolve {
-        /// Stored (leaf, link) coefficients.
+        /// (leaf, link) coefficients and source weights.
         entries: usize,
+        /// Whether they exceed the budget: the coefficients beyond it are computed again at every
+        /// iteration (slower, same answer).
+        over_budget: bool,
     },
     /// A solve finished.
     Solved {
@@ -231,6 +243,99 @@ pub struct LevelReport {
 /// from the links, cannot see.
 pub const BALANCE_SHARE_OF_TARGET: f64 = 0.5;
 
+/// Why the refinement levels stopped short of the target error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopCause {
+    /// The memory budget ([`Config::max_memory_bytes`]) refused subdivisions.
+    MemoryBudget,
+    /// The most levels ([`Config::max_levels`]) were solved.
+    MaxLevels,
+    /// A level subdivided nothing, or changed no polygon mean while the estimate did not fall:
+    /// refinement no longer moves the answer.
+    NoProgress,
+    /// The estimate is below the target but the power balance gap (daylight) did not move with
+    /// the last level: light lost or created outside the links, which refinement cannot recover.
+    BalanceGap,
+}
+
+impl StopCause {
+    /// Whether a budget stopped the levels (the answer could have met its target with more).
+    #[must_use]
+    pub fn is_budget(self) -> bool {
+        self == StopCause::MemoryBudget
+    }
+}
+
+/// A target error the solve did not reach (`stats.json` `target_missed`).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct TargetMissed {
+    /// The target error.
+    pub target: f64,
+    /// The error estimate reached.
+    pub error_estimate: f64,
+    /// With daylight, the power balance gap reached ([`LevelReport::balance_gap`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub balance_gap: Option<f64>,
+    /// Why the levels stopped.
+    pub stopped_by: StopCause,
+    /// The memory budget, bytes, when it stopped them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub budget_bytes: Option<usize>,
+    /// Levels solved.
+    pub levels: usize,
+}
+
+impl TargetMissed {
+    /// One line for the console and `solve_warnings`.
+    #[must_use]
+    pub fn message(&self) -> String {
+        let why = match self.stopped_by {
+            StopCause::MemoryBudget => format!(
+                "the memory budget of {:.0} MB stopped refinement (raise --max-memory, or accept the answer with --allow-over-budget)",
+                self.budget_bytes.unwrap_or(0) as f64 / 1e6
+            ),
+            StopCause::MaxLevels => format!("the most levels ({}) were solved", self.levels),
+            StopCause::NoProgress => {
+                format!(
+                    "refinement stopped moving the answer ({NO_PROGRESS_LEVELS} levels in a row changed no polygon mean and left the estimate)"
+                )
+            }
+            StopCause::BalanceGap => format!(
+                "the power balance gap {:.2}% did not move with refinement: light lost or created outside the links, which finer links cannot recover",
+                100.0 * self.balance_gap.unwrap_or(f64::NAN)
+            ),
+        };
+        format!("target error {} not reached: estimate {:.3e} after {} levels; {why}", self.target, self.error_estimate, self.levels)
+    }
+}
+
+/// The leaf-resolution operator was over its budget ([`Config::leaf_operator_max_entries`] or
+/// what the memory budget left): coefficients computed again at every iteration instead of stored.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct LeafOverBudget {
+    /// Levels whose operator was over its budget.
+    pub levels: usize,
+    /// The largest share of an operator's coefficients not stored.
+    pub recomputed_share: f64,
+    /// The budget of stored coefficients.
+    pub budget_entries: usize,
+}
+
+/// Below this fraction of the target a level's change of the polygon means counts as none
+/// ([`StopCause::NoProgress`]).
+pub const NO_CHANGE_SHARE_OF_TARGET: f64 = 0.01;
+/// An estimate that fell by less than this fraction of itself over a level did not fall
+/// ([`StopCause::NoProgress`]).
+pub const ESTIMATE_MIN_FALL: f64 = 0.1;
+/// Consecutive levels that changed nothing and did not lower the estimate before the levels stop
+/// ([`StopCause::NoProgress`]): a level whose finer thresholds subdivide nothing may be followed
+/// by one that does, two in a row are not.
+pub const NO_PROGRESS_LEVELS: usize = 2;
+/// A balance gap that fell by less than this fraction of itself over a level did not move
+/// ([`StopCause::BalanceGap`]).
+pub const BALANCE_GAP_MIN_FALL: f64 = 0.1;
+
 /// The result of [`run`].
 pub struct Solved {
     /// The element hierarchy.
@@ -273,6 +378,12 @@ pub struct Solved {
     /// What the solve could not do as asked, in words (memory budget reached, target error not
     /// reached).
     pub warnings: Vec<String>,
+    /// The target error, when the solve ended without reaching it: what it reached and why the
+    /// levels stopped.
+    pub target_missed: Option<TargetMissed>,
+    /// Levels whose leaf-resolution operator was over its budget, and the largest share of its
+    /// coefficients that was computed again at every iteration instead of stored.
+    pub leaf_over_budget: Option<LeafOverBudget>,
     /// Operator applications summed over passes.
     pub iterations: usize,
     /// Time per phase.
@@ -324,6 +435,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let mut iterations = 0;
     let mut levels = Vec::new();
     let mut leaf_entries = 0;
+    let mut target_missed = None;
+    let mut stale_levels = 0;
+    let mut over_budget = None;
     // A target error needs the estimate (and the leaf-resolution solve it is made with).
     let target_error = config.target_error.filter(|_| config.estimate_error && config.final_gather);
     let n_levels = if target_error.is_some() { config.max_levels.max(1) } else { config.levels.max(1) };
@@ -367,7 +481,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             iterations += sol.iterations;
             progress(Progress::Solved { pass: passes, iterations: sol.iterations, residual: sol.residual });
             if pass < config.max_passes.max(1) {
+                let t = Instant::now();
                 update_data(&mut data, &h, &links, &sol, config);
+                timings.refine += t.elapsed().as_secs_f64();
             }
             level_solution = Some(sol);
         }
@@ -375,19 +491,33 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let sol = level_solution.expect("every level solves at least once");
         let budget = config.max_memory_bytes.saturating_sub(h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK);
         let leaf_budget = config.leaf_operator_max_entries.min(budget / solve::LEAF_OPERATOR_ENTRY_BYTES);
-        let (sol, more_iterations, entries) = finish_solve(&h, &links, sol, config, leaf_budget, closed, progress, passes, &mut None);
+        let mut leaf = None;
+        let (sol, more_iterations, _) =
+            finish_solve(&h, &links, sol, config, leaf_budget, closed, progress, passes, &mut leaf, config.stream_leaf_operator);
+        if let Some(c) = leaf.as_ref().filter(|c| !c.is_complete()) {
+            let share = c.recomputed_share();
+            let over = over_budget.get_or_insert(LeafOverBudget { levels: 0, recomputed_share: 0.0, budget_entries: leaf_budget });
+            over.levels += 1;
+            over.recomputed_share = over.recomputed_share.max(share);
+            over.budget_entries = over.budget_entries.min(leaf_budget);
+        }
+        leaf_entries = leaf.as_ref().map_or(0, solve::LeafCoefficients::entries);
+        drop(leaf);
         iterations += more_iterations;
-        leaf_entries = entries;
         timings.solve += t.elapsed().as_secs_f64();
+        let t = Instant::now();
         if level + 1 < n_levels {
             update_data(&mut data, &h, &links, &sol, config);
         }
+        timings.refine += t.elapsed().as_secs_f64();
+        let t = Instant::now();
         let means: Vec<[f64; 3]> = crate::output::polygon_results(&h, &sol).into_iter().map(|r| r.b).collect();
         let change = history.push(means);
         let last = level + 1 == n_levels || stats.refused_for_memory > 0;
-        let estimate = (config.estimate_error && entries > 0 && (target_error.is_some() || last))
-            .then(|| estimate_error(&h, &links, &sol, closed, config));
+        let estimate = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
+            .then(|| estimate_error(&h, &links, &sol, closed, config, leaf_budget));
         let balance_gap = (!h.distant.is_empty() && target_error.is_some()).then(|| crate::daylight::balance_gap(&h, &sol, &caster));
+        timings.estimate += t.elapsed().as_secs_f64();
         let report = LevelReport {
             balance_gap,
             threshold_scale: scale,
@@ -399,16 +529,51 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             time_s: t0.elapsed().as_secs_f64(),
         };
         progress(Progress::Level { level: level + 1, report });
+        let previous = levels.last().copied();
         levels.push(report);
         solution = Some(sol);
-        let reached = match (target_error, estimate) {
-            (Some(target), Some(e)) => e <= target && balance_gap.is_none_or(|g| g <= BALANCE_SHARE_OF_TARGET * target),
-            _ => false,
+        let Some(target) = target_error else {
+            if stats.refused_for_memory > 0 {
+                break;
+            }
+            continue;
         };
-        // Without an estimate (the leaf-resolution operator over its budget) a target cannot be
-        // checked: stop at this level.
-        let unestimated = target_error.is_some() && estimate.is_none();
-        if reached || unestimated || stats.refused_for_memory > 0 {
+        let estimate = estimate.unwrap_or(f64::INFINITY);
+        let gap_closed = balance_gap.is_none_or(|g| g <= BALANCE_SHARE_OF_TARGET * target);
+        if estimate <= target && gap_closed {
+            break;
+        }
+        let stop = if stats.refused_for_memory > 0 {
+            Some(StopCause::MemoryBudget)
+        } else if let Some(prev) = previous {
+            let unchanged = change.is_some_and(|c| c <= NO_CHANGE_SHARE_OF_TARGET * target)
+                && prev.error_estimate.is_some_and(|e| estimate >= (1.0 - ESTIMATE_MIN_FALL) * e);
+            stale_levels = if unchanged { stale_levels + 1 } else { 0 };
+            let gap_stuck = estimate <= target
+                && match (prev.balance_gap, balance_gap) {
+                    (Some(before), Some(now)) => now >= (1.0 - BALANCE_GAP_MIN_FALL) * before,
+                    _ => false,
+                };
+            if gap_stuck {
+                Some(StopCause::BalanceGap)
+            } else if stale_levels >= NO_PROGRESS_LEVELS {
+                Some(StopCause::NoProgress)
+            } else {
+                None
+            }
+        } else {
+            None
+        };
+        let stop = stop.or((level + 1 == n_levels).then_some(StopCause::MaxLevels));
+        if let Some(cause) = stop {
+            target_missed = Some(TargetMissed {
+                target,
+                error_estimate: estimate,
+                balance_gap,
+                stopped_by: cause,
+                budget_bytes: cause.is_budget().then_some(config.max_memory_bytes),
+                levels: levels.len(),
+            });
             break;
         }
     }
@@ -428,13 +593,17 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             stats.refused_for_memory
         ));
     }
-    match (target_error, error_estimate) {
-        (Some(target), Some(e)) if e > target => {
-            warnings.push(format!("target error {target} not reached: estimate {e:.3e} after {} levels", levels.len()))
-        }
-        (Some(target), None) => warnings
-            .push(format!("target error {target} not checked: the leaf-resolution solve, which the estimate needs, is over its budget")),
-        _ => {}
+    if let Some(o) = &over_budget {
+        warnings.push(format!(
+            "leaf-resolution solve over its budget of {} stored coefficients on {} level(s): up to {:.0}% of them computed again at \
+             every iteration (slower; the same answer)",
+            o.budget_entries,
+            o.levels,
+            100.0 * o.recomputed_share
+        ));
+    }
+    if let Some(m) = &target_missed {
+        warnings.push(m.message());
     }
     let rays = caster.rays_cast() + shaft_rays.load(Ordering::Relaxed);
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
@@ -447,6 +616,8 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         escape_fraction,
         closed,
         warnings,
+        target_missed,
+        leaf_over_budget: over_budget,
         refine_stats: stats,
         rays,
         passes,
@@ -475,13 +646,13 @@ fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solu
 /// the same links solved on the mesh one and two levels coarser ([`solve::Cut::coarsened`]), the
 /// Richardson extrapolation of the three, with the visibility-sampling noise
 /// ([`solve::visibility_noise`]) where that is larger, times [`solve::ESTIMATE_SAFETY`].
-fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config) -> f64 {
+fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config, max_stored: usize) -> f64 {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
     let mut means = vec![crate::output::polygon_results(h, sol).into_iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
-        let coefficients = solve::LeafCoefficients::for_cut(&cut, links, closed);
-        let op = solve::LeafOperator::for_cut(cut, &coefficients);
+        let coefficients = solve::LeafCoefficients::for_cut(&cut, links, closed, max_stored);
+        let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
         means.push(crate::output::polygon_results(h, &coarse).into_iter().map(|r| r.b).collect());
     }
@@ -511,13 +682,15 @@ pub fn effective_visibility(oracle: &dyn Oracle, requested: VisibilityMethod) ->
 pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
     let sol = solve::solve(h, links, &ElementData::first_guess(h).radiosity, &config.solve);
     let first = sol.iterations;
-    let (sol, more, entries) = finish_solve(h, links, sol, config, config.leaf_operator_max_entries, false, &|_| {}, 1, leaf);
+    let (sol, more, entries) = finish_solve(h, links, sol, config, config.leaf_operator_max_entries, false, &|_| {}, 1, leaf, false);
     (sol, first + more, entries)
 }
 
 /// The final gather step after the hierarchical solve, with the leaf-resolution coefficients of
-/// `leaf` (computed and kept there when absent and within `max_entries`): `(solution, iterations,
-/// leaf entries)`.
+/// `leaf` (computed and kept there when absent): `(solution, iterations, leaf entries)`. Over
+/// `max_entries` coefficients, with `stream` the coefficients beyond the budget are computed again
+/// at every iteration (the same answer, slower); without, one gather pass is done instead
+/// ([`solve::final_gather`]).
 #[allow(clippy::too_many_arguments)]
 fn finish_solve(
     h: &Hierarchy,
@@ -529,15 +702,17 @@ fn finish_solve(
     progress: &dyn Fn(Progress),
     passes: usize,
     leaf: &mut Option<solve::LeafCoefficients>,
+    stream: bool,
 ) -> (Solution, usize, usize) {
     if !config.final_gather {
         return (solution, 0, 0);
     }
     if leaf.is_none() {
         let entries = solve::leaf_operator_entries(h, links);
-        if entries <= max_entries {
-            progress(Progress::LeafSolve { entries });
-            *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed));
+        let over_budget = entries > max_entries;
+        if stream || !over_budget {
+            progress(Progress::LeafSolve { entries, over_budget });
+            *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed, max_entries));
         }
     }
     match leaf {

@@ -36,7 +36,12 @@ impl Reporter {
             Progress::Refine { level, pass, links, pending } => {
                 format!("level {level}, refine pass {pass}: {links} links, {pending} candidates pending")
             }
-            Progress::LeafSolve { entries } => format!("leaf-resolution solve: {entries} coefficients"),
+            Progress::LeafSolve { entries, over_budget } => {
+                format!(
+                    "leaf-resolution solve: {entries} coefficients{}",
+                    if over_budget { " (over budget: recomputed each iteration)" } else { "" }
+                )
+            }
             Progress::Solved { pass, iterations, residual } => {
                 format!("solve pass {pass}: {iterations} iterations, residual {residual:.1e}")
             }

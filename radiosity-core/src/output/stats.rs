@@ -14,6 +14,12 @@ pub struct StatsTimes {
     pub refine: f64,
     /// Linear solves.
     pub solve: f64,
+    /// The error estimate (solves on coarsened meshes, visibility noise) and the per-level power
+    /// balance.
+    pub estimate: f64,
+    /// Solves after the first, with `solve --time-for` (absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub repeats: Option<f64>,
     /// Writing outputs.
     pub output: f64,
     /// Everything.
@@ -107,6 +113,17 @@ pub struct Stats {
     /// What the solve could not do as asked, in words (memory budget reached, target error not
     /// reached).
     pub solve_warnings: Vec<String>,
+    /// The target error, when the solve ended without reaching it: the estimate it reached, why
+    /// the levels stopped (`memory_budget`, `max_levels`, `no_progress`, `balance_gap`) and the
+    /// budget that stopped them (absent when the target was reached or none was set).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target_missed: Option<crate::pipeline::TargetMissed>,
+    /// The leaf-resolution operator was over its budget: coefficients computed again at every
+    /// iteration instead of stored (absent when within).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub leaf_over_budget: Option<crate::pipeline::LeafOverBudget>,
+    /// Stored coefficients and weights of the last leaf-resolution operator.
+    pub leaf_operator_entries: usize,
     /// Input warnings (degenerate faces skipped, etc.).
     pub warnings: crate::scene::SceneWarnings,
     /// Calculation points gathered (`solve --points`; absent without).
@@ -273,6 +290,8 @@ impl Stats {
                 build: solved.timings.build,
                 refine: solved.timings.refine,
                 solve: solved.timings.solve,
+                estimate: solved.timings.estimate,
+                repeats: None,
                 output,
                 total,
                 runs: 1,
@@ -294,6 +313,9 @@ impl Stats {
             closed: solved.closed,
             memory_limited: solved.memory_limited,
             solve_warnings: solved.warnings.clone(),
+            target_missed: solved.target_missed,
+            leaf_over_budget: solved.leaf_over_budget,
+            leaf_operator_entries: solved.leaf_entries,
             warnings: scene.warnings.clone(),
             points: None,
             point_rays: None,

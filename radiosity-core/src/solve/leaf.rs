@@ -25,9 +25,10 @@
 //! and the other side scaled to it.
 //!
 //! The operator is solved to convergence with GMRES, starting from the hierarchical solution. It
-//! stores one coefficient per (leaf, chain link) and one weight per (link source, leaf below it);
-//! when that exceeds the budget the caller falls back to one gather pass
-//! ([`super::final_gather`]).
+//! stores one `f32` coefficient per (leaf, chain link), in chain order (the link is implied), and
+//! one weight per (link source, leaf below it); beyond a budget of coefficients the remaining
+//! leaves' coefficients are computed again at every application, so that a budget costs time but
+//! never changes the answer.
 
 use super::cut::Cut;
 use crate::formfactor::{self, FormFactorQuality};
@@ -35,10 +36,15 @@ use crate::hierarchy::{ElementId, Hierarchy, NONE};
 use crate::refine::Link;
 use rayon::prelude::*;
 
-/// Default budget of leaf-operator entries: (leaf, link) coefficients and (source, leaf) weights.
-pub const LEAF_OPERATOR_MAX_ENTRIES: usize = 40_000_000;
-/// Bytes of one leaf-operator entry (element id and coefficient).
-pub const LEAF_OPERATOR_ENTRY_BYTES: usize = 12;
+/// Default budget of stored leaf-operator coefficients (480 MB of `f32`, what 40 M coefficients
+/// with their link indices in `f64` took before): beyond it the coefficients of the remaining
+/// unknowns are recomputed at every application instead of stored ([`LeafCoefficients::for_cut`]):
+/// the same operator, bit for bit, only slower.
+pub const LEAF_OPERATOR_MAX_ENTRIES: usize = 120_000_000;
+/// Bytes of one stored leaf-operator coefficient: an `f32`; the link it belongs to is implied by
+/// its place in the unknown's chain of links (receivers from the unknown up to the root, each
+/// receiver's links in a fixed order), so it is not stored.
+pub const LEAF_OPERATOR_ENTRY_BYTES: usize = 4;
 
 /// Source leaves farther from a receiver than this many times the sum of their bounding radii get
 /// their weight from the point form factor at their centre rather than the precise one (the
@@ -48,20 +54,36 @@ pub const WEIGHT_FAR_SEPARATION: f64 = 4.0;
 /// Per-leaf gather lists over the chain of ancestor links, with conservative source values.
 pub struct LeafOperator<'a> {
     cut: Cut<'a>,
+    links: &'a [Link],
     lists: &'a LeafCoefficients,
 }
 
 /// The coefficients of a [`LeafOperator`]: geometry only (form factors and visibility), so they
 /// serve every emission of the same hierarchy and links (the instanced solver keeps them with a
 /// level it reuses).
+///
+/// Each unknown's coefficients along its chain of links (`F(unknown ← source) V`, rounded to
+/// `f32`) are stored in chain order for the first [`LeafCoefficients::stored_unknowns`] unknowns,
+/// and recomputed, identically, at every application for the rest (beyond the budget the
+/// coefficients were built with). What makes the operator conserve energy is kept per link, in
+/// `f64`: the receiver side's scale and the source side's weights.
 #[derive(Clone, Debug)]
 pub struct LeafCoefficients {
-    /// Start of each leaf's entries in `link`/`coef` (length leaves + 1), leaves in
-    /// [`super::Operator`] order.
+    /// Link indices sorted by (receiver, source), and each element's range in it.
+    sorted: Vec<u32>,
+    range: Vec<(u32, u32)>,
+    /// Start of each stored unknown's chain coefficients in `coef` (length stored + 1).
     start: Vec<usize>,
-    /// The link of each entry (an index into the links the coefficients were built for).
-    link: Vec<u32>,
-    coef: Vec<f64>,
+    coef: Vec<f32>,
+    /// Chain coefficients of every unknown, stored or not.
+    chain_entries: usize,
+    /// Links received inside an unknown (below it, on a coarsened cut): `(link, coefficient)`
+    /// ranges per unknown (empty at leaf resolution).
+    inside_start: Vec<u32>,
+    inside: Vec<(u32, f64)>,
+    /// Per link: the factor on its receiver-side coefficients that makes them carry the link's
+    /// transfer (and, in a closed scene, the closure factor of its source).
+    scale: Vec<f64>,
     /// Per link, where its source value comes from.
     value: Vec<SourceValue>,
     /// Weights of source leaves: `(leaf, weight)` ranges referred to by [`SourceValue`].
@@ -98,6 +120,10 @@ enum SourceValue {
 /// source's leaves by their own kernel; farther links share one set of weights per source (the
 /// kernel varies little over a far source).
 pub const OWN_WEIGHTS_SEPARATION: f64 = 4.0;
+
+/// Chain coefficients computed at a time while the receiver totals of unstored unknowns are
+/// summed (a bounded buffer, filled in parallel, summed in order).
+const STREAM_BATCH_ENTRIES: usize = 1 << 20;
 
 /// The unknowns of a cut below each element, as ranges of one depth-first list (an element at or
 /// below the cut has none: its value is its cut ancestor's).
@@ -146,45 +172,124 @@ fn own_weights(h: &Hierarchy, below: &LeavesBelow, l: &Link) -> bool {
     below.below(l.source).len() > 1 && (s.center - r.center).length() < OWN_WEIGHTS_SEPARATION * (s.radius + r.radius)
 }
 
+/// The chain of links of one unknown: every link received at the unknown or an ancestor, in the
+/// order coefficients are stored in.
+#[derive(Clone, Copy)]
+struct Chain<'c> {
+    h: &'c Hierarchy,
+    links: &'c [Link],
+    sorted: &'c [u32],
+    range: &'c [(u32, u32)],
+}
+
+impl Chain<'_> {
+    /// Number of links on the chain of `leaf`.
+    fn len(&self, leaf: ElementId) -> usize {
+        let mut n = 0;
+        let mut a = leaf;
+        while a != NONE {
+            let (lo, hi) = self.range[a as usize];
+            n += (hi - lo) as usize;
+            a = self.h.get(a).parent;
+        }
+        n
+    }
+
+    /// Calls `f(link)` for every link on the chain of `leaf`, in storage order.
+    fn for_each_link(&self, leaf: ElementId, mut f: impl FnMut(u32)) {
+        let mut a = leaf;
+        while a != NONE {
+            let (lo, hi) = self.range[a as usize];
+            for &k in &self.sorted[lo as usize..hi as usize] {
+                f(k);
+            }
+            a = self.h.get(a).parent;
+        }
+    }
+
+    /// Calls `f(link, F(leaf ← source) V)` for every link on the chain of `leaf`, in storage order:
+    /// a link at the leaf with its stored form factor, one at an ancestor with the leaf's own
+    /// ([`shape_form_factor`]); negative values (quadrature noise) as 0, every value rounded to
+    /// `f32` as it is stored.
+    fn for_each(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
+        let mut a = leaf;
+        while a != NONE {
+            let (lo, hi) = self.range[a as usize];
+            for &k in &self.sorted[lo as usize..hi as usize] {
+                let l = &self.links[k as usize];
+                let ff = if a == leaf { l.ff } else { shape_form_factor(self.h, l.source, leaf) };
+                let c = ff * l.vis;
+                f(k, if c > 0.0 { c as f32 } else { 0.0 });
+            }
+            a = self.h.get(a).parent;
+        }
+    }
+
+    /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets
+    /// relative to `coef`, length `unknowns.len() + 1`), in parallel.
+    fn fill(&self, unknowns: &[ElementId], start: &[usize], coef: &mut [f32]) {
+        let mut slices: Vec<&mut [f32]> = Vec::with_capacity(unknowns.len());
+        let mut rest = coef;
+        for w in start.windows(2) {
+            let (a, b) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+            slices.push(a);
+            rest = b;
+        }
+        slices.into_par_iter().zip(unknowns.par_iter()).with_min_len(16).for_each(|(out, &u)| {
+            let mut j = 0;
+            self.for_each(u, |_, c| {
+                out[j] = c;
+                j += 1;
+            });
+        });
+    }
+}
+
 impl LeafCoefficients {
     /// Evaluates `link_form_factor(source, leaf)` for every leaf and every link on its chain, and
     /// the source weights, each link's two sides scaled to the same transfer (see the module docs).
     #[must_use]
     pub fn new(h: &Hierarchy, links: &[Link]) -> LeafCoefficients {
-        LeafCoefficients::for_cut(&Cut::leaves(h), links, false)
+        LeafCoefficients::for_cut(&Cut::leaves(h), links, false, usize::MAX)
     }
 
     /// [`LeafCoefficients::new`] with the unknowns of `cut` in place of the leaves: a link received
     /// below an unknown adds its transfer to the unknown's mean (area-weighted), a link sent from
     /// below one sends the unknown's radiosity. In a `closed` scene every unknown's light is
-    /// delivered whole ([`LeafCoefficients::closure`]).
+    /// delivered whole ([`LeafCoefficients::closure`]). Chain coefficients are stored for the
+    /// unknowns, in cut order, whose coefficients fit in `max_stored` with those before them; the
+    /// others' are recomputed at every application (see [`LeafCoefficients::stored_unknowns`]).
     #[must_use]
-    pub fn for_cut(cut: &Cut<'_>, links: &[Link], closed: bool) -> LeafCoefficients {
+    pub fn for_cut(cut: &Cut<'_>, links: &[Link], closed: bool, max_stored: usize) -> LeafCoefficients {
         let h = cut.hierarchy();
-        let index = LinksByReceiver::new(h, links);
-        // Receiver side: per unknown, (link index, F(unknown ← source) V).
-        let lists: Vec<Vec<(u32, f64)>> = cut
-            .elements()
+        let LinksByReceiver { sorted, range, .. } = LinksByReceiver::new(h, links);
+        let chain = Chain { h, links, sorted: &sorted, range: &range };
+        let unknowns = cut.elements();
+        // Receiver side, along each unknown's chain: stored while within the budget.
+        let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
+        let chain_entries: usize = lens.iter().sum();
+        let mut start = Vec::with_capacity(unknowns.len() + 1);
+        start.push(0);
+        for &len in &lens {
+            let next = start[start.len() - 1] + len;
+            if next > max_stored {
+                break;
+            }
+            start.push(next);
+        }
+        let stored = start.len() - 1;
+        let mut coef = vec![0.0f32; start[stored]];
+        chain.fill(&unknowns[..stored], &start, &mut coef);
+        // Links received inside an unknown: their transfer, spread over its area.
+        let inside_lists: Vec<Vec<(u32, f64)>> = unknowns
             .par_iter()
-            .map(|&leaf| {
+            .map(|&u| {
+                let area = h.get(u).area;
                 let mut list = Vec::new();
-                let mut a = leaf;
-                while a != NONE {
-                    for &k in index.indices_at(a) {
-                        let l = &links[k as usize];
-                        let ff = if a == leaf { l.ff } else { shape_form_factor(h, l.source, leaf) };
-                        let c = ff * l.vis;
-                        if c > 0.0 {
-                            list.push((k, c));
-                        }
-                    }
-                    a = h.get(a).parent;
-                }
-                // Links received inside the unknown: their transfer, spread over its area.
-                let area = h.get(leaf).area;
-                let mut stack: Vec<ElementId> = h.children_of(leaf).to_vec();
+                let mut stack: Vec<ElementId> = h.children_of(u).to_vec();
                 while let Some(d) = stack.pop() {
-                    for &k in index.indices_at(d) {
+                    let (lo, hi) = range[d as usize];
+                    for &k in &sorted[lo as usize..hi as usize] {
                         let l = &links[k as usize];
                         let c = h.get(d).area / area * l.ff * l.vis;
                         if c > 0.0 {
@@ -196,109 +301,122 @@ impl LeafCoefficients {
                 list
             })
             .collect();
+        let mut inside_start = Vec::with_capacity(unknowns.len() + 1);
+        inside_start.push(0u32);
+        let mut inside = Vec::new();
+        for list in inside_lists {
+            inside.extend(list);
+            inside_start.push(inside.len() as u32);
+        }
+        // The receiver side's total per link, `Σ_unknowns A F V`, summed in cut order (unstored
+        // unknowns' coefficients computed a batch at a time).
         let mut receiver_total = vec![0.0; links.len()];
-        for (&leaf, list) in cut.elements().iter().zip(&lists) {
-            let area = h.get(leaf).area;
-            for &(k, c) in list {
+        for (i, &u) in unknowns[..stored].iter().enumerate() {
+            let area = h.get(u).area;
+            let mut j = start[i];
+            chain.for_each_link(u, |k| {
+                receiver_total[k as usize] += area * f64::from(coef[j]);
+                j += 1;
+            });
+            for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
                 receiver_total[k as usize] += area * c;
             }
         }
-        // Source side: per link, A_y F(y ← receiver) V for every unknown y below the source.
-        let below = LeavesBelow::new(cut);
-        let source_shares: Vec<Vec<f64>> = links
-            .par_iter()
-            .map(|l| below.below(l.source).iter().map(|&y| h.get(y).area * weight_form_factor(h, l.receiver, y) * l.vis).collect())
-            .collect();
+        let mut first = stored;
+        let mut buffer = Vec::new();
+        while first < unknowns.len() {
+            let mut batch_start = vec![0];
+            let mut last = first;
+            while last < unknowns.len() && (last == first || batch_start[batch_start.len() - 1] + lens[last] <= STREAM_BATCH_ENTRIES) {
+                batch_start.push(batch_start[batch_start.len() - 1] + lens[last]);
+                last += 1;
+            }
+            buffer.clear();
+            buffer.resize(batch_start[batch_start.len() - 1], 0.0f32);
+            chain.fill(&unknowns[first..last], &batch_start, &mut buffer);
+            for (i, &u) in (first..last).zip(&unknowns[first..last]) {
+                let area = h.get(u).area;
+                let mut j = batch_start[i - first];
+                chain.for_each_link(u, |k| {
+                    receiver_total[k as usize] += area * f64::from(buffer[j]);
+                    j += 1;
+                });
+                for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
+                    receiver_total[k as usize] += area * c;
+                }
+            }
+            first = last;
+        }
+        drop(buffer);
         // The transfer each link carries, from the side evaluated exactly: between surfaces the
         // link's own `A_R F V` (its precise form factor); from a surface to a cluster the sum over
         // the receiver's unknowns (each with its precise form factor from the surface); from a
-        // cluster to a surface the sum over the source's unknowns (likewise, by reciprocity);
-        // between clusters the receiver's sum.
-        let transfer: Vec<f64> = links
+        // cluster to a surface the sum over the source's unknowns (likewise, by reciprocity, set
+        // with the source side below); between clusters the receiver's sum.
+        let mut transfer: Vec<f64> = links
             .iter()
             .enumerate()
             .map(|(k, l)| {
-                let (s_surface, r_surface) = (h.get(l.source).poly().is_some(), h.get(l.receiver).poly().is_some());
-                let source_total: f64 = source_shares[k].iter().sum();
-                match (s_surface, r_surface) {
-                    (true, true) => h.get(l.receiver).area * l.ff * l.vis,
-                    (false, true) if source_total > 0.0 => source_total,
-                    _ => receiver_total[k],
+                if h.get(l.source).poly().is_some() && h.get(l.receiver).poly().is_some() {
+                    h.get(l.receiver).area * l.ff * l.vis
+                } else {
+                    receiver_total[k]
                 }
             })
             .collect();
-        let mut start = Vec::with_capacity(lists.len() + 1);
-        let total: usize = lists.iter().map(Vec::len).sum();
-        let mut link = Vec::with_capacity(total);
-        let mut coef = Vec::with_capacity(total);
-        start.push(0);
-        for list in lists {
-            for (k, c) in list {
-                let scale = if receiver_total[k as usize] > 0.0 { transfer[k as usize] / receiver_total[k as usize] } else { 1.0 };
-                link.push(k);
-                coef.push(c * scale);
-            }
-            start.push(link.len());
-        }
-        // Source values: an unknown's own radiosity (a source at or below the cut sends its cut
-        // ancestor's); a near link's own weights; the shared weights of a source's far links (each
-        // link's shares scaled to its transfer, then summed).
-        let (mut weight_leaf, mut weight) = (Vec::new(), Vec::new());
+        // Source side: per link, `A_y F(y ← receiver) V` for every unknown `y` below a source
+        // above the cut, computed per source (its links together) and kept only as weights.
+        let below = LeavesBelow::new(cut);
         let mut value = vec![SourceValue::Leaf(NONE); links.len()];
-        let mut far: Vec<u32> = Vec::new();
+        let mut by_source: Vec<u32> = Vec::new();
         for (k, l) in links.iter().enumerate() {
-            if let Some(i) = cut.unknown_of(l.source) {
-                value[k] = SourceValue::Leaf(cut.elements()[i]);
-            } else if own_weights(h, &below, l) {
-                let shares = &source_shares[k];
-                let sum: f64 = shares.iter().sum();
-                let begin = weight.len() as u32;
-                weight_leaf.extend_from_slice(below.below(l.source));
-                if sum > 0.0 {
-                    weight.extend(shares.iter().map(|x| x / sum));
-                } else {
-                    let area = h.get(l.source).area;
-                    weight.extend(below.below(l.source).iter().map(|&y| h.get(y).area / area));
-                }
-                value[k] = SourceValue::Own(begin, weight.len() as u32);
-            } else {
-                far.push(k as u32);
+            match cut.unknown_of(l.source) {
+                Some(i) => value[k] = SourceValue::Leaf(unknowns[i]),
+                None => by_source.push(k as u32),
             }
         }
-        far.sort_by_key(|&k| (links[k as usize].source, k));
+        by_source.sort_by_key(|&k| (links[k as usize].source, k));
+        let groups: Vec<&[u32]> = by_source.chunk_by(|&a, &b| links[a as usize].source == links[b as usize].source).collect();
+        let results: Vec<SourceWeights> = groups.par_iter().map(|group| source_weights(h, links, &below, group, &transfer)).collect();
+        let (mut weight_leaf, mut weight) = (Vec::new(), Vec::new());
         let mut shared = Vec::new();
-        let mut i = 0;
-        while i < far.len() {
-            let s = links[far[i] as usize].source;
-            let leaves = below.below(s);
-            let begin = weight.len();
-            weight_leaf.extend_from_slice(leaves);
-            weight.resize(begin + leaves.len(), 0.0);
-            while i < far.len() && links[far[i] as usize].source == s {
-                let k = far[i] as usize;
-                let shares = &source_shares[k];
-                let total: f64 = shares.iter().sum();
-                if total > 0.0 {
-                    let scale = transfer[k] / total;
-                    for (w, x) in weight[begin..].iter_mut().zip(shares) {
-                        *w += scale * x;
-                    }
-                }
-                value[k] = SourceValue::Shared(shared.len() as u32);
-                i += 1;
+        for (group, r) in groups.iter().zip(results) {
+            let s = links[group[0] as usize].source;
+            for (k, t) in r.transfer {
+                transfer[k as usize] = t;
             }
-            let sum: f64 = weight[begin..].iter().sum();
-            if sum > 0.0 {
-                weight[begin..].iter_mut().for_each(|w| *w /= sum);
-            } else {
-                let area = h.get(s).area;
-                for (w, &y) in weight[begin..].iter_mut().zip(leaves) {
-                    *w = h.get(y).area / area;
-                }
+            for (k, w) in r.own {
+                let begin = weight.len() as u32;
+                weight_leaf.extend_from_slice(below.below(s));
+                weight.extend(w);
+                value[k as usize] = SourceValue::Own(begin, weight.len() as u32);
             }
-            shared.push((s, begin, weight.len()));
+            if let Some(w) = r.shared {
+                let begin = weight.len();
+                weight_leaf.extend_from_slice(below.below(s));
+                weight.extend(w);
+                for &k in r.far.iter() {
+                    value[k as usize] = SourceValue::Shared(shared.len() as u32);
+                }
+                shared.push((s, begin, weight.len()));
+            }
         }
-        let mut c = LeafCoefficients { start, link, coef, value, weight_leaf, weight, shared, closure: (1.0, 1.0) };
+        let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
+        let mut c = LeafCoefficients {
+            sorted,
+            range,
+            start,
+            coef,
+            chain_entries,
+            inside_start,
+            inside,
+            scale,
+            value,
+            weight_leaf,
+            weight,
+            shared,
+            closure: (1.0, 1.0),
+        };
         if closed {
             c.close(cut, &transfer);
         }
@@ -374,18 +492,12 @@ impl LeafCoefficients {
                 rescale(lo, hi)
             })
             .collect();
-        let link_scale: Vec<f64> = self
-            .value
-            .iter()
-            .zip(&own_scale)
-            .map(|(v, own)| match *v {
+        for ((s, v), own) in self.scale.iter_mut().zip(&self.value).zip(&own_scale) {
+            *s *= match *v {
                 SourceValue::Leaf(e) => f(e),
                 SourceValue::Own(..) => own.unwrap_or(1.0),
                 SourceValue::Shared(i) => shared_scale[i as usize],
-            })
-            .collect();
-        for (c, &k) in self.coef.iter_mut().zip(&self.link) {
-            *c *= link_scale[k as usize];
+            };
         }
         let (lo, hi) = factor.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
         self.closure = if factor.is_empty() { (1.0, 1.0) } else { (lo, hi) };
@@ -394,15 +506,45 @@ impl LeafCoefficients {
     /// Stored coefficients and weights.
     #[must_use]
     pub fn entries(&self) -> usize {
-        self.coef.len() + self.weight.len()
+        self.coef.len() + self.inside.len() + self.weight.len()
+    }
+
+    /// Chain coefficients of every unknown, stored or recomputed at every application.
+    #[must_use]
+    pub fn chain_entries(&self) -> usize {
+        self.chain_entries
+    }
+
+    /// How many unknowns (the first ones, in cut order) have their chain coefficients stored; the
+    /// others' are recomputed at every application, giving the same values.
+    #[must_use]
+    pub fn stored_unknowns(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// The share of the chain coefficients computed again at every application (0 when all are
+    /// stored).
+    #[must_use]
+    pub fn recomputed_share(&self) -> f64 {
+        if self.chain_entries == 0 { 0.0 } else { 1.0 - self.coef.len() as f64 / self.chain_entries as f64 }
+    }
+
+    /// Whether every unknown's chain coefficients are stored.
+    #[must_use]
+    pub fn is_complete(&self) -> bool {
+        self.stored_unknowns() + 1 == self.inside_start.len()
     }
 
     /// Heap bytes held.
     #[must_use]
     pub fn bytes(&self) -> usize {
-        self.start.len() * size_of::<usize>()
-            + self.link.len() * size_of::<u32>()
-            + self.coef.len() * size_of::<f64>()
+        self.sorted.len() * size_of::<u32>()
+            + self.range.len() * size_of::<(u32, u32)>()
+            + self.start.len() * size_of::<usize>()
+            + self.coef.len() * size_of::<f32>()
+            + self.inside_start.len() * size_of::<u32>()
+            + self.inside.len() * size_of::<(u32, f64)>()
+            + self.scale.len() * size_of::<f64>()
             + self.value.len() * size_of::<SourceValue>()
             + self.weight_leaf.len() * size_of::<ElementId>()
             + self.weight.len() * size_of::<f64>()
@@ -410,7 +552,7 @@ impl LeafCoefficients {
     }
 
     /// The radiosity each link sends (see the module docs), for leaf radiosity read from `b` (per
-    /// element).
+    /// element), times the link's receiver-side scale.
     fn link_values(&self, b: &[[f64; 3]]) -> Vec<[f64; 3]> {
         let weighted = |lo: usize, hi: usize| {
             let mut acc = [0.0; 3];
@@ -425,13 +567,71 @@ impl LeafCoefficients {
         let shared: Vec<[f64; 3]> = self.shared.par_iter().map(|&(_, lo, hi)| weighted(lo, hi)).collect();
         self.value
             .par_iter()
-            .map(|v| match *v {
-                SourceValue::Leaf(e) => b[e as usize],
-                SourceValue::Own(lo, hi) => weighted(lo as usize, hi as usize),
-                SourceValue::Shared(i) => shared[i as usize],
+            .zip(&self.scale)
+            .map(|(v, &s)| {
+                let x = match *v {
+                    SourceValue::Leaf(e) => b[e as usize],
+                    SourceValue::Own(lo, hi) => weighted(lo as usize, hi as usize),
+                    SourceValue::Shared(i) => shared[i as usize],
+                };
+                x.map(|x| x * s)
             })
             .collect()
     }
+}
+
+/// What the source side of one source's links gives: the transfer of its links from a cluster to
+/// a surface (the sum over the source's unknowns), each near link's own weights, and the far
+/// links' shared weights.
+struct SourceWeights {
+    transfer: Vec<(u32, f64)>,
+    own: Vec<(u32, Vec<f64>)>,
+    far: Vec<u32>,
+    shared: Option<Vec<f64>>,
+}
+
+/// The source side of the links of `group` (one source above the cut): each link's shares
+/// `A_y F(y ← receiver) V` over the source's unknowns `y`, normalised into its own weights (a near
+/// link) or, scaled to the link's transfer, summed into the source's shared weights (far links).
+fn source_weights(h: &Hierarchy, links: &[Link], below: &LeavesBelow, group: &[u32], transfer: &[f64]) -> SourceWeights {
+    let s = links[group[0] as usize].source;
+    let leaves = below.below(s);
+    let area_weights = || -> Vec<f64> {
+        let area = h.get(s).area;
+        leaves.iter().map(|&y| h.get(y).area / area).collect()
+    };
+    let mut out = SourceWeights { transfer: Vec::new(), own: Vec::new(), far: Vec::new(), shared: None };
+    let mut acc: Vec<f64> = Vec::new();
+    let mut shares = Vec::with_capacity(leaves.len());
+    for &k in group {
+        let l = &links[k as usize];
+        shares.clear();
+        shares.extend(leaves.iter().map(|&y| h.get(y).area * weight_form_factor(h, l.receiver, y) * l.vis));
+        let total: f64 = shares.iter().sum();
+        let mut t = transfer[k as usize];
+        if h.get(l.source).poly().is_none() && h.get(l.receiver).poly().is_some() && total > 0.0 {
+            t = total;
+            out.transfer.push((k, t));
+        }
+        if own_weights(h, below, l) {
+            let w = if total > 0.0 { shares.iter().map(|x| x / total).collect() } else { area_weights() };
+            out.own.push((k, w));
+        } else {
+            acc.resize(leaves.len(), 0.0);
+            if total > 0.0 {
+                let scale = t / total;
+                for (w, x) in acc.iter_mut().zip(&shares) {
+                    *w += scale * x;
+                }
+            }
+            out.far.push(k);
+        }
+    }
+    if !out.far.is_empty() {
+        let sum: f64 = acc.iter().sum();
+        out.shared = Some(if sum > 0.0 { acc.iter().map(|w| w / sum).collect() } else { area_weights() });
+    }
+    out
 }
 
 /// The form factor `F(leaf ← source)` that shares a link's transfer among the receiver's leaves:
@@ -549,15 +749,15 @@ impl<'a> LeafOperator<'a> {
     /// The operator of `h` and `links` with coefficients computed by [`LeafCoefficients::new`] for
     /// the same hierarchy and links (the emission may have changed since).
     #[must_use]
-    pub fn new(h: &'a Hierarchy, _links: &[Link], coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
-        LeafOperator { cut: Cut::leaves(h), lists: coefficients }
+    pub fn new(h: &'a Hierarchy, links: &'a [Link], coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
+        LeafOperator { cut: Cut::leaves(h), links, lists: coefficients }
     }
 
     /// The operator on the unknowns of `cut`, with coefficients computed by
-    /// [`LeafCoefficients::for_cut`] for the same cut and links.
+    /// [`LeafCoefficients::for_cut`] for the same cut and `links`.
     #[must_use]
-    pub fn for_cut(cut: Cut<'a>, coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
-        LeafOperator { cut, lists: coefficients }
+    pub fn for_cut(cut: Cut<'a>, links: &'a [Link], coefficients: &'a LeafCoefficients) -> LeafOperator<'a> {
+        LeafOperator { cut, links, lists: coefficients }
     }
 
     /// The unknowns (leaf order, pull, emission).
@@ -572,22 +772,41 @@ impl<'a> LeafOperator<'a> {
         self.lists.entries()
     }
 
-    /// Irradiance of every unknown (in cut order) for the unknowns' radiosity `x`.
+    /// Irradiance of every unknown (in cut order) for the unknowns' radiosity `x`. Unknowns whose
+    /// chain coefficients are not stored compute them again, to the same values.
     #[must_use]
     pub fn gather_leaves(&self, x: &[f64]) -> Vec<[f64; 3]> {
         let b = self.cut.pull(x);
         let l = self.lists;
         let values = l.link_values(&b);
+        let chain = Chain { h: self.cut.hierarchy(), links: self.links, sorted: &l.sorted, range: &l.range };
+        let stored = l.stored_unknowns();
+        let unknowns = self.cut.elements();
         (0..self.cut.len())
             .into_par_iter()
             .map(|i| {
                 let mut acc = [0.0; 3];
-                for k in l.start[i]..l.start[i + 1] {
-                    let bs = values[l.link[k] as usize];
-                    let c = l.coef[k];
+                let mut add = |k: u32, c: f32| {
+                    let bs = values[k as usize];
+                    let c = f64::from(c);
                     acc[0] += c * bs[0];
                     acc[1] += c * bs[1];
                     acc[2] += c * bs[2];
+                };
+                if i < stored {
+                    let mut j = l.start[i];
+                    chain.for_each_link(unknowns[i], |k| {
+                        add(k, l.coef[j]);
+                        j += 1;
+                    });
+                } else {
+                    chain.for_each(unknowns[i], &mut add);
+                }
+                for &(k, c) in &l.inside[l.inside_start[i] as usize..l.inside_start[i + 1] as usize] {
+                    let bs = values[k as usize];
+                    for ch in 0..3 {
+                        acc[ch] += c * bs[ch];
+                    }
                 }
                 acc
             })

@@ -232,6 +232,7 @@ pub(super) fn local_pipeline(config: &InstancedConfig) -> pipeline::Config {
         target_error: None,
         solve: config.local_solve,
         leaf_operator_max_entries: config.local_leaf_operator_max_entries,
+        stream_leaf_operator: false,
         ..config.pipeline
     }
 }
