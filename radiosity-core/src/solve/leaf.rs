@@ -311,9 +311,11 @@ impl LeafCoefficients {
         // The receiver side's total per link, `Σ_unknowns A F V`, summed in cut order (unstored
         // unknowns' coefficients computed a batch at a time).
         let mut receiver_total = vec![0.0; links.len()];
-        for (i, &u) in unknowns[..stored].iter().enumerate() {
+        // Adds unknown `i`'s `A F V` to its links' totals, its chain coefficients read from `coef`.
+        let mut add_unknown = |i: usize, coef: &[f32]| {
+            let u = unknowns[i];
             let area = h.get(u).area;
-            let mut j = start[i];
+            let mut j = 0;
             chain.for_each_link(u, |k| {
                 receiver_total[k as usize] += area * f64::from(coef[j]);
                 j += 1;
@@ -321,6 +323,9 @@ impl LeafCoefficients {
             for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
                 receiver_total[k as usize] += area * c;
             }
+        };
+        for i in 0..stored {
+            add_unknown(i, &coef[start[i]..start[i + 1]]);
         }
         let mut first = stored;
         let mut buffer = Vec::new();
@@ -334,16 +339,8 @@ impl LeafCoefficients {
             buffer.clear();
             buffer.resize(batch_start[batch_start.len() - 1], 0.0f32);
             chain.fill(&unknowns[first..last], &batch_start, &mut buffer);
-            for (i, &u) in (first..last).zip(&unknowns[first..last]) {
-                let area = h.get(u).area;
-                let mut j = batch_start[i - first];
-                chain.for_each_link(u, |k| {
-                    receiver_total[k as usize] += area * f64::from(buffer[j]);
-                    j += 1;
-                });
-                for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
-                    receiver_total[k as usize] += area * c;
-                }
+            for i in first..last {
+                add_unknown(i, &buffer[batch_start[i - first]..batch_start[i - first + 1]]);
             }
             first = last;
         }
