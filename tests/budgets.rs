@@ -51,10 +51,11 @@ fn a_leaf_operator_over_its_budget_costs_time_not_the_answer() {
     let target = 0.01;
     let config = Config { target_error: Some(target), ..Config::default() };
     let stored = pipeline::run(&c.scene, &BfHand::default(), &config, &|_| {});
-    let tight = Config { leaf_operator_max_entries: 20_000, ..config };
+    let tight = Config { leaf_operator_max_bytes: 40_000, ..config };
     let streamed = pipeline::run(&c.scene, &BfHand::default(), &tight, &|_| {});
     assert!(stored.leaf_over_budget.is_none(), "{:?}", stored.leaf_over_budget);
     let over = streamed.leaf_over_budget.expect("the budget is reported");
+    assert_eq!(over.budget_entries, 20_000, "2 bytes a coefficient: {over:?}");
     assert!(over.recomputed_share > 0.5, "most coefficients recomputed: {over:?}");
     assert!(streamed.warnings.iter().any(|w| w.contains("leaf-resolution solve over its budget")), "{:?}", streamed.warnings);
     assert_eq!(means(&stored), means(&streamed), "a budget must not change the answer");
@@ -62,6 +63,22 @@ fn a_leaf_operator_over_its_budget_costs_time_not_the_answer() {
     let truth = validation::true_error(&c.reference, &means(&streamed));
     assert!(truth <= target, "true error {truth:.3e} over the target {target}");
     assert!(streamed.target_missed.is_none());
+}
+
+/// The same with `f32` coefficients (a solve without a target error stores them in `f32`, one
+/// with a target of 0.01 in 16 bits): over its budget, bit for bit the same answer.
+#[test]
+fn a_single_precision_leaf_operator_over_its_budget_gives_the_same_answer() {
+    let c = case("ward-room");
+    let config = Config { target_error: None, ..Config::default() };
+    let stored = pipeline::run(&c.scene, &BfHand::default(), &config, &|_| {});
+    let tight = Config { leaf_operator_max_bytes: 4_000, ..config };
+    let streamed = pipeline::run(&c.scene, &BfHand::default(), &tight, &|_| {});
+    assert!(stored.leaf_over_budget.is_none(), "{:?}", stored.leaf_over_budget);
+    let over = streamed.leaf_over_budget.unwrap_or_else(|| panic!("the budget is reported ({} entries)", stored.leaf_entries));
+    assert_eq!(over.budget_entries, 1_000, "4 bytes a coefficient: {over:?}");
+    assert!(over.recomputed_share > 0.5, "most coefficients recomputed: {over:?}");
+    assert_eq!(means(&stored), means(&streamed), "a budget must not change the answer");
 }
 
 /// A memory budget that stops refinement short of the target: the command writes its outputs,

@@ -45,12 +45,13 @@ pub struct Config {
     pub analyse: bool,
     /// After the last hierarchical solve of a level, solve again at leaf resolution (every leaf
     /// gathers from its chain of links with its own form factors, see [`solve::LeafOperator`]);
-    /// when that would store more than `leaf_operator_max_entries` coefficients, one gather pass is
+    /// when that would store more than `leaf_operator_max_bytes` of coefficients, one gather pass is
     /// done instead.
     pub final_gather: bool,
-    /// Budget of the leaf-resolution operator's stored coefficients
-    /// ([`solve::LEAF_OPERATOR_ENTRY_BYTES`] each).
-    pub leaf_operator_max_entries: usize,
+    /// Budget of the leaf-resolution operator's stored coefficients, in bytes (each takes
+    /// [`solve::Precision::bytes`]: 2 with a target error of at least [`solve::HALF_MIN_TARGET`],
+    /// 4 otherwise).
+    pub leaf_operator_max_bytes: usize,
     /// Over that budget, store what fits and compute the rest again at every iteration (the same
     /// answer, slower); off: do one gather pass instead of the leaf-resolution solve (an
     /// approximation, what the instanced solver's local problems do to stay small).
@@ -88,7 +89,7 @@ impl Default for Config {
             analyse: true,
             visibility_method: VisibilityMethod::Rays,
             final_gather: true,
-            leaf_operator_max_entries: solve::LEAF_OPERATOR_MAX_ENTRIES,
+            leaf_operator_max_bytes: solve::LEAF_OPERATOR_MAX_BYTES,
             stream_leaf_operator: true,
             estimate_error: true,
             measure_variation: true,
@@ -310,7 +311,7 @@ impl TargetMissed {
     }
 }
 
-/// The leaf-resolution operator was over its budget ([`Config::leaf_operator_max_entries`] or
+/// The leaf-resolution operator was over its budget ([`Config::leaf_operator_max_bytes`] or
 /// what the memory budget left): coefficients computed again at every iteration instead of stored.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
 pub struct LeafOverBudget {
@@ -318,8 +319,10 @@ pub struct LeafOverBudget {
     pub levels: usize,
     /// The largest share of an operator's coefficients not stored.
     pub recomputed_share: f64,
-    /// The budget of stored coefficients.
+    /// The budget of stored coefficients: how many.
     pub budget_entries: usize,
+    /// The budget of stored coefficients in bytes.
+    pub budget_bytes: usize,
 }
 
 /// Below this fraction of the target a level's change of the polygon means counts as none
@@ -490,16 +493,19 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let t = Instant::now();
         let sol = level_solution.expect("every level solves at least once");
         let budget = config.max_memory_bytes.saturating_sub(h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK);
-        let leaf_budget = config.leaf_operator_max_entries.min(budget / solve::LEAF_OPERATOR_ENTRY_BYTES);
+        let leaf_budget = config.leaf_operator_max_bytes.min(budget);
         let mut leaf = None;
         let (sol, more_iterations, _) =
             finish_solve(&h, &links, sol, config, leaf_budget, closed, progress, passes, &mut leaf, config.stream_leaf_operator);
         if let Some(c) = leaf.as_ref().filter(|c| !c.is_complete()) {
             let share = c.recomputed_share();
-            let over = over_budget.get_or_insert(LeafOverBudget { levels: 0, recomputed_share: 0.0, budget_entries: leaf_budget });
+            let over = over_budget.get_or_insert(LeafOverBudget { levels: 0, recomputed_share: 0.0, budget_entries: usize::MAX, budget_bytes: 0 });
             over.levels += 1;
             over.recomputed_share = over.recomputed_share.max(share);
-            over.budget_entries = over.budget_entries.min(leaf_budget);
+            let entries = leaf_budget / c.precision().bytes();
+            if entries < over.budget_entries {
+                (over.budget_entries, over.budget_bytes) = (entries, leaf_budget);
+            }
         }
         leaf_entries = leaf.as_ref().map_or(0, solve::LeafCoefficients::entries);
         drop(leaf);
@@ -646,12 +652,12 @@ fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solu
 /// the same links solved on the mesh one and two levels coarser ([`solve::Cut::coarsened`]), the
 /// Richardson extrapolation of the three, with the visibility-sampling noise
 /// ([`solve::visibility_noise`]) where that is larger, times [`solve::ESTIMATE_SAFETY`].
-fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config, max_stored: usize) -> f64 {
+fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config, max_bytes: usize) -> f64 {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
     let mut means = vec![crate::output::polygon_results(h, sol).into_iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
-        let coefficients = solve::LeafCoefficients::for_cut(&cut, links, closed, max_stored);
+        let coefficients = solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error));
         let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
         means.push(crate::output::polygon_results(h, &coarse).into_iter().map(|r| r.b).collect());
@@ -676,19 +682,19 @@ pub fn effective_visibility(oracle: &dyn Oracle, requested: VisibilityMethod) ->
 /// the instanced solver reuses one refinement for every instance of a prototype): the
 /// hierarchical solve, then the leaf-resolution solve or gather of [`Config::final_gather`]. `leaf`
 /// keeps the leaf-resolution coefficients between calls for the same hierarchy and links (computed
-/// at the first call when within [`Config::leaf_operator_max_entries`]). Returns the solution, the
+/// at the first call when within [`Config::leaf_operator_max_bytes`]). Returns the solution, the
 /// iterations and the leaf-operator entries (0 when gathered).
 #[must_use]
 pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
     let sol = solve::solve(h, links, &ElementData::first_guess(h).radiosity, &config.solve);
     let first = sol.iterations;
-    let (sol, more, entries) = finish_solve(h, links, sol, config, config.leaf_operator_max_entries, false, &|_| {}, 1, leaf, false);
+    let (sol, more, entries) = finish_solve(h, links, sol, config, config.leaf_operator_max_bytes, false, &|_| {}, 1, leaf, false);
     (sol, first + more, entries)
 }
 
 /// The final gather step after the hierarchical solve, with the leaf-resolution coefficients of
-/// `leaf` (computed and kept there when absent): `(solution, iterations, leaf entries)`. Over
-/// `max_entries` coefficients, with `stream` the coefficients beyond the budget are computed again
+/// `leaf` (computed and kept there when absent, in the [`solve::Precision`] of the target error):
+/// `(solution, iterations, leaf entries)`. Over `max_bytes` of coefficients, with `stream` the coefficients beyond the budget are computed again
 /// at every iteration (the same answer, slower); without, one gather pass is done instead
 /// ([`solve::final_gather`]).
 #[allow(clippy::too_many_arguments)]
@@ -697,7 +703,7 @@ fn finish_solve(
     links: &[Link],
     mut solution: Solution,
     config: &Config,
-    max_entries: usize,
+    max_bytes: usize,
     closed: bool,
     progress: &dyn Fn(Progress),
     passes: usize,
@@ -708,11 +714,12 @@ fn finish_solve(
         return (solution, 0, 0);
     }
     if leaf.is_none() {
+        let precision = solve::Precision::for_target(config.target_error);
         let entries = solve::leaf_operator_entries(h, links);
-        let over_budget = entries > max_entries;
+        let over_budget = entries.saturating_mul(precision.bytes()) > max_bytes;
         if stream || !over_budget {
             progress(Progress::LeafSolve { entries, over_budget });
-            *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed, max_entries));
+            *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed, max_bytes, precision));
         }
     }
     match leaf {

@@ -36,15 +36,123 @@ use crate::hierarchy::{ElementId, Hierarchy, NONE};
 use crate::refine::Link;
 use rayon::prelude::*;
 
-/// Default budget of stored leaf-operator coefficients (480 MB of `f32`, what 40 M coefficients
-/// with their link indices in `f64` took before): beyond it the coefficients of the remaining
-/// unknowns are recomputed at every application instead of stored ([`LeafCoefficients::for_cut`]):
-/// the same operator, bit for bit, only slower.
-pub const LEAF_OPERATOR_MAX_ENTRIES: usize = 120_000_000;
-/// Bytes of one stored leaf-operator coefficient: an `f32`; the link it belongs to is implied by
-/// its place in the unknown's chain of links (receivers from the unknown up to the root, each
-/// receiver's links in a fixed order), so it is not stored.
-pub const LEAF_OPERATOR_ENTRY_BYTES: usize = 4;
+/// Default budget of the leaf-resolution operator's stored coefficients, in bytes (what 40 M
+/// coefficients with their link indices in `f64` took before): beyond it the coefficients of the
+/// remaining unknowns are recomputed at every application instead of stored
+/// ([`LeafCoefficients::for_cut`]): the same operator, bit for bit, only slower.
+pub const LEAF_OPERATOR_MAX_BYTES: usize = 480_000_000;
+
+/// How the leaf operator stores its chain coefficients (the link each belongs to is implied by its
+/// place in the unknown's chain of links, so only the value is stored).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// `f32`: 4 bytes, rounding below 1e-7 relative.
+    Single,
+    /// A 16-bit logarithmic code of the values in `[2⁻⁴⁶, 4)`: 2 bytes, rounding at most
+    /// [`HALF_ROUNDING`] relative; smaller values (below 1.5e-14, where a form factor is 1 at most)
+    /// are dropped.
+    Half,
+}
+
+/// Largest relative rounding of a [`Precision::Half`] coefficient: half a step of the code,
+/// `2^(24/65534) − 1` = 2.54e-4, with the `f32` rounding of the value and of its decoded form.
+pub const HALF_ROUNDING: f64 = 2.6e-4;
+
+/// Smallest target error whose solves store [`Precision::Half`] coefficients: each coefficient is
+/// then rounded by at most a quarter of the target (and the rounding, of either sign from one
+/// coefficient to the next, averages out over a polygon's leaves). Finer targets, and solves
+/// without one, store `f32`.
+pub const HALF_MIN_TARGET: f64 = 1e-3;
+
+/// Log₂ of the smallest [`Precision::Half`] code's value.
+const CODE_LOG2_MIN: f64 = -46.0;
+/// Octaves the [`Precision::Half`] codes span.
+const CODE_LOG2_SPAN: f64 = 48.0;
+/// Steps between the smallest and the largest code (code 0 is zero).
+const CODE_STEPS: f64 = 65534.0;
+
+impl Precision {
+    /// The precision of a solve with `target` error ([`HALF_MIN_TARGET`]).
+    #[must_use]
+    pub fn for_target(target: Option<f64>) -> Precision {
+        match target {
+            Some(t) if t >= HALF_MIN_TARGET => Precision::Half,
+            _ => Precision::Single,
+        }
+    }
+
+    /// Bytes of one stored coefficient.
+    #[must_use]
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::Single => size_of::<f32>(),
+            Precision::Half => size_of::<u16>(),
+        }
+    }
+
+    /// The value a coefficient `c` (non-negative) is applied with: `c` itself, or its code's value.
+    #[must_use]
+    pub fn round(self, c: f32) -> f32 {
+        match self {
+            Precision::Single => c,
+            Precision::Half => decode(encode(c)),
+        }
+    }
+}
+
+/// The [`Precision::Half`] code of `c ≥ 0`: 0 below the smallest code's value, otherwise the
+/// nearest code on the logarithmic scale (values from 4 up get the largest code; form factors are
+/// below 1).
+fn encode(c: f32) -> u16 {
+    let c = f64::from(c);
+    if c.is_nan() || c < CODE_LOG2_MIN.exp2() {
+        return 0;
+    }
+    let t = ((c.log2() - CODE_LOG2_MIN) * (CODE_STEPS / CODE_LOG2_SPAN)).round();
+    1 + t.min(CODE_STEPS) as u16
+}
+
+/// The value of a [`Precision::Half`] code.
+fn decode(code: u16) -> f32 {
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..=u16::MAX)
+            .map(|code| if code == 0 { 0.0 } else { (CODE_LOG2_MIN + f64::from(code - 1) * (CODE_LOG2_SPAN / CODE_STEPS)).exp2() as f32 })
+            .collect()
+    });
+    table[usize::from(code)]
+}
+
+/// Stored chain coefficients, in either [`Precision`].
+#[derive(Clone, Debug)]
+enum Stored {
+    Single(Vec<f32>),
+    Half(Vec<u16>),
+}
+
+impl Stored {
+    fn len(&self) -> usize {
+        match self {
+            Stored::Single(v) => v.len(),
+            Stored::Half(v) => v.len(),
+        }
+    }
+
+    fn precision(&self) -> Precision {
+        match self {
+            Stored::Single(_) => Precision::Single,
+            Stored::Half(_) => Precision::Half,
+        }
+    }
+
+    /// The value coefficient `j` is applied with.
+    fn get(&self, j: usize) -> f32 {
+        match self {
+            Stored::Single(v) => v[j],
+            Stored::Half(v) => decode(v[j]),
+        }
+    }
+}
 
 /// Source leaves farther from a receiver than this many times the sum of their bounding radii get
 /// their weight from the point form factor at their centre rather than the precise one (the
@@ -74,7 +182,7 @@ pub struct LeafCoefficients {
     range: Vec<(u32, u32)>,
     /// Start of each stored unknown's chain coefficients in `coef` (length stored + 1).
     start: Vec<usize>,
-    coef: Vec<f32>,
+    coef: Stored,
     /// Chain coefficients of every unknown, stored or not.
     chain_entries: usize,
     /// Links received inside an unknown (below it, on a coarsened cut): `(link, coefficient)`
@@ -180,6 +288,7 @@ struct Chain<'c> {
     links: &'c [Link],
     sorted: &'c [u32],
     range: &'c [(u32, u32)],
+    precision: Precision,
 }
 
 impl Chain<'_> {
@@ -210,8 +319,8 @@ impl Chain<'_> {
     /// Calls `f(link, F(leaf ← source) V)` for every link on the chain of `leaf`, in storage order:
     /// a link at the leaf with its stored form factor, one at an ancestor with the leaf's own
     /// ([`shape_form_factor`]); negative values (quadrature noise) as 0, every value rounded to
-    /// `f32` as it is stored.
-    fn for_each(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
+    /// `f32` (and then to the chain's [`Precision`] by [`Chain::for_each`]).
+    fn for_each_raw(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
         let mut a = leaf;
         while a != NONE {
             let (lo, hi) = self.range[a as usize];
@@ -225,10 +334,17 @@ impl Chain<'_> {
         }
     }
 
+    /// [`Chain::for_each_raw`] with every value as it is applied in the chain's [`Precision`]: what
+    /// a stored coefficient decodes to.
+    fn for_each(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
+        let p = self.precision;
+        self.for_each_raw(leaf, |k, c| f(k, p.round(c)));
+    }
+
     /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets
-    /// relative to `coef`, length `unknowns.len() + 1`), in parallel.
-    fn fill(&self, unknowns: &[ElementId], start: &[usize], coef: &mut [f32]) {
-        let mut slices: Vec<&mut [f32]> = Vec::with_capacity(unknowns.len());
+    /// relative to `coef`, length `unknowns.len() + 1`), each as `store` turns it, in parallel.
+    fn fill<T: Send>(&self, unknowns: &[ElementId], start: &[usize], coef: &mut [T], store: impl Fn(f32) -> T + Sync) {
+        let mut slices: Vec<&mut [T]> = Vec::with_capacity(unknowns.len());
         let mut rest = coef;
         for w in start.windows(2) {
             let (a, b) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
@@ -237,8 +353,8 @@ impl Chain<'_> {
         }
         slices.into_par_iter().zip(unknowns.par_iter()).with_min_len(16).for_each(|(out, &u)| {
             let mut j = 0;
-            self.for_each(u, |_, c| {
-                out[j] = c;
+            self.for_each_raw(u, |_, c| {
+                out[j] = store(c);
                 j += 1;
             });
         });
@@ -250,20 +366,22 @@ impl LeafCoefficients {
     /// the source weights, each link's two sides scaled to the same transfer (see the module docs).
     #[must_use]
     pub fn new(h: &Hierarchy, links: &[Link]) -> LeafCoefficients {
-        LeafCoefficients::for_cut(&Cut::leaves(h), links, false, usize::MAX)
+        LeafCoefficients::for_cut(&Cut::leaves(h), links, false, usize::MAX, Precision::Single)
     }
 
     /// [`LeafCoefficients::new`] with the unknowns of `cut` in place of the leaves: a link received
     /// below an unknown adds its transfer to the unknown's mean (area-weighted), a link sent from
     /// below one sends the unknown's radiosity. In a `closed` scene every unknown's light is
-    /// delivered whole ([`LeafCoefficients::closure`]). Chain coefficients are stored for the
-    /// unknowns, in cut order, whose coefficients fit in `max_stored` with those before them; the
-    /// others' are recomputed at every application (see [`LeafCoefficients::stored_unknowns`]).
+    /// delivered whole ([`LeafCoefficients::closure`]). Chain coefficients are stored in
+    /// `precision` for the unknowns, in cut order, whose coefficients fit in `max_bytes` with
+    /// those before them; the others' are recomputed at every application (see
+    /// [`LeafCoefficients::stored_unknowns`]).
     #[must_use]
-    pub fn for_cut(cut: &Cut<'_>, links: &[Link], closed: bool, max_stored: usize) -> LeafCoefficients {
+    pub fn for_cut(cut: &Cut<'_>, links: &[Link], closed: bool, max_bytes: usize, precision: Precision) -> LeafCoefficients {
         let h = cut.hierarchy();
         let LinksByReceiver { sorted, range, .. } = LinksByReceiver::new(h, links);
-        let chain = Chain { h, links, sorted: &sorted, range: &range };
+        let chain = Chain { h, links, sorted: &sorted, range: &range, precision };
+        let max_stored = max_bytes / precision.bytes();
         let unknowns = cut.elements();
         // Receiver side, along each unknown's chain: stored while within the budget.
         let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
@@ -278,8 +396,18 @@ impl LeafCoefficients {
             start.push(next);
         }
         let stored = start.len() - 1;
-        let mut coef = vec![0.0f32; start[stored]];
-        chain.fill(&unknowns[..stored], &start, &mut coef);
+        let coef = match precision {
+            Precision::Single => {
+                let mut v = vec![0.0f32; start[stored]];
+                chain.fill(&unknowns[..stored], &start, &mut v, |c| c);
+                Stored::Single(v)
+            }
+            Precision::Half => {
+                let mut v = vec![0u16; start[stored]];
+                chain.fill(&unknowns[..stored], &start, &mut v, encode);
+                Stored::Half(v)
+            }
+        };
         // Links received inside an unknown: their transfer, spread over its area.
         let inside_lists: Vec<Vec<(u32, f64)>> = unknowns
             .par_iter()
@@ -311,13 +439,13 @@ impl LeafCoefficients {
         // The receiver side's total per link, `Σ_unknowns A F V`, summed in cut order (unstored
         // unknowns' coefficients computed a batch at a time).
         let mut receiver_total = vec![0.0; links.len()];
-        // Adds unknown `i`'s `A F V` to its links' totals, its chain coefficients read from `coef`.
-        let mut add_unknown = |i: usize, coef: &[f32]| {
+        // Adds unknown `i`'s `A F V` to its links' totals, its `j`th chain coefficient `coef(j)`.
+        let mut add_unknown = |i: usize, coef: &dyn Fn(usize) -> f32| {
             let u = unknowns[i];
             let area = h.get(u).area;
             let mut j = 0;
             chain.for_each_link(u, |k| {
-                receiver_total[k as usize] += area * f64::from(coef[j]);
+                receiver_total[k as usize] += area * f64::from(coef(j));
                 j += 1;
             });
             for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
@@ -325,7 +453,7 @@ impl LeafCoefficients {
             }
         };
         for i in 0..stored {
-            add_unknown(i, &coef[start[i]..start[i + 1]]);
+            add_unknown(i, &|j| coef.get(start[i] + j));
         }
         let mut first = stored;
         let mut buffer = Vec::new();
@@ -338,9 +466,10 @@ impl LeafCoefficients {
             }
             buffer.clear();
             buffer.resize(batch_start[batch_start.len() - 1], 0.0f32);
-            chain.fill(&unknowns[first..last], &batch_start, &mut buffer);
+            chain.fill(&unknowns[first..last], &batch_start, &mut buffer, |c| precision.round(c));
             for i in first..last {
-                add_unknown(i, &buffer[batch_start[i - first]..batch_start[i - first + 1]]);
+                let b = &buffer[batch_start[i - first]..];
+                add_unknown(i, &|j| b[j]);
             }
             first = last;
         }
@@ -500,6 +629,12 @@ impl LeafCoefficients {
         self.closure = if factor.is_empty() { (1.0, 1.0) } else { (lo, hi) };
     }
 
+    /// How the chain coefficients are stored.
+    #[must_use]
+    pub fn precision(&self) -> Precision {
+        self.coef.precision()
+    }
+
     /// Stored coefficients and weights.
     #[must_use]
     pub fn entries(&self) -> usize {
@@ -538,7 +673,7 @@ impl LeafCoefficients {
         self.sorted.len() * size_of::<u32>()
             + self.range.len() * size_of::<(u32, u32)>()
             + self.start.len() * size_of::<usize>()
-            + self.coef.len() * size_of::<f32>()
+            + self.coef.len() * self.coef.precision().bytes()
             + self.inside_start.len() * size_of::<u32>()
             + self.inside.len() * size_of::<(u32, f64)>()
             + self.scale.len() * size_of::<f64>()
@@ -776,7 +911,7 @@ impl<'a> LeafOperator<'a> {
         let b = self.cut.pull(x);
         let l = self.lists;
         let values = l.link_values(&b);
-        let chain = Chain { h: self.cut.hierarchy(), links: self.links, sorted: &l.sorted, range: &l.range };
+        let chain = Chain { h: self.cut.hierarchy(), links: self.links, sorted: &l.sorted, range: &l.range, precision: l.coef.precision() };
         let stored = l.stored_unknowns();
         let unknowns = self.cut.elements();
         (0..self.cut.len())
@@ -792,10 +927,16 @@ impl<'a> LeafOperator<'a> {
                 };
                 if i < stored {
                     let mut j = l.start[i];
-                    chain.for_each_link(unknowns[i], |k| {
-                        add(k, l.coef[j]);
-                        j += 1;
-                    });
+                    match &l.coef {
+                        Stored::Single(v) => chain.for_each_link(unknowns[i], |k| {
+                            add(k, v[j]);
+                            j += 1;
+                        }),
+                        Stored::Half(v) => chain.for_each_link(unknowns[i], |k| {
+                            add(k, decode(v[j]));
+                            j += 1;
+                        }),
+                    }
                 } else {
                     chain.for_each(unknowns[i], &mut add);
                 }
@@ -834,5 +975,36 @@ impl<'a> LeafOperator<'a> {
         let hs = self.gather_leaves(x);
         let irr = self.cut.pull(hs.as_flattened());
         (b, irr)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every value in the code's range comes back within [`HALF_ROUNDING`], in order; zero and
+    /// values below the range come back as zero; `f32` values are kept as they are.
+    #[test]
+    fn half_coefficients_round_by_at_most_half_rounding() {
+        let (lo, hi) = (CODE_LOG2_MIN.exp2(), 3.99f64);
+        let n = 400_000;
+        let mut worst = 0.0f64;
+        let mut last = 0.0f32;
+        for i in 0..=n {
+            let c = (lo * (hi / lo).powf(f64::from(i) / f64::from(n))) as f32;
+            let r = Precision::Half.round(c);
+            worst = worst.max((f64::from(r) - f64::from(c)).abs() / f64::from(c));
+            assert!(r >= last, "decoded values out of order at {c}: {r} < {last}");
+            last = r;
+        }
+        assert!(worst <= HALF_ROUNDING, "relative rounding {worst:.3e} over {HALF_ROUNDING:.1e}");
+        assert!(worst > 0.5 * HALF_ROUNDING, "the bound is tight: {worst:.3e}");
+        assert_eq!(Precision::Half.round(0.0), 0.0);
+        assert_eq!(Precision::Half.round((0.4 * lo) as f32), 0.0);
+        assert_eq!(Precision::Single.round(0.123_456_78), 0.123_456_78);
+        assert_eq!(Precision::for_target(Some(0.01)), Precision::Half);
+        assert_eq!(Precision::for_target(Some(HALF_MIN_TARGET)), Precision::Half);
+        assert_eq!(Precision::for_target(Some(0.0003)), Precision::Single);
+        assert_eq!(Precision::for_target(None), Precision::Single);
     }
 }

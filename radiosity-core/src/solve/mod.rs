@@ -20,7 +20,7 @@ pub use estimate::{
 };
 pub use final_gather::{area_means, final_gather, top_down};
 pub use gmres::{GmresResult, gmres};
-pub use leaf::{LEAF_OPERATOR_ENTRY_BYTES, LEAF_OPERATOR_MAX_ENTRIES, LeafCoefficients, LeafOperator, leaf_operator_entries};
+pub use leaf::{HALF_MIN_TARGET, HALF_ROUNDING, LEAF_OPERATOR_MAX_BYTES, LeafCoefficients, LeafOperator, Precision, leaf_operator_entries};
 pub use operator::Operator;
 pub use ranges::element_data;
 

@@ -25,10 +25,11 @@ pub struct InstancedConfig {
     /// problem (one vector of all elements per iteration), and a relative residual of 1e-7 is far
     /// below the method's approximation error.
     pub local_solve: crate::solve::SolveConfig,
-    /// Budget of a local problem's leaf-resolution operator (coefficients of 12 bytes); a larger
-    /// problem (the top level of a forest) does one leaf-level gather pass instead. It caps the
-    /// second-largest allocation of a local problem.
-    pub local_leaf_operator_max_entries: usize,
+    /// Budget of a local problem's leaf-resolution operator, in bytes of stored coefficients (4
+    /// each: local problems have no target error); a larger problem (the top level of a forest)
+    /// does one leaf-level gather pass instead. It caps the second-largest allocation of a local
+    /// problem.
+    pub local_leaf_operator_max_bytes: usize,
     /// An instance whose box lies nearer to an emitter of its level than this many times its own
     /// diagonal is opened in place: a closed instance receives the light as parallel beams, which
     /// misses how much brighter its near side is under a close light.
@@ -109,7 +110,7 @@ impl Default for InstancedConfig {
             max_closed_polygons: 20_000,
             trace: false,
             local_solve: crate::solve::SolveConfig { tolerance: 1e-7, max_iterations: 2000, restart: 10 },
-            local_leaf_operator_max_entries: 250_000,
+            local_leaf_operator_max_bytes: 1_000_000,
             open_near_emitter: 1.0,
             level_cache_bytes: 16_000_000,
             instance_levels: InstanceLevels::All,
@@ -231,7 +232,7 @@ pub(super) fn local_pipeline(config: &InstancedConfig) -> pipeline::Config {
         measure_variation: false,
         target_error: None,
         solve: config.local_solve,
-        leaf_operator_max_entries: config.local_leaf_operator_max_entries,
+        leaf_operator_max_bytes: config.local_leaf_operator_max_bytes,
         stream_leaf_operator: false,
         ..config.pipeline
     }
