@@ -193,11 +193,13 @@ fn sliver_furnace_is_exact() {
     assert!(worst <= 1e-4, "worst polygon off by {worst}");
 }
 
-/// The error estimate is not below the true error on the validation scenes, at several eps.
+/// The error estimate is not below the true error on the validation scenes, at several eps; at 0.64
+/// most polygons are left whole (Ward's room: 13 leaves for 10 polygons, true error 7.6%), which
+/// the coarser meshes do not show (the estimate said 0.001% before it counted them).
 #[test]
 fn estimate_is_not_below_the_true_error() {
     for c in validation::cases() {
-        for eps in [0.04, 0.01, 0.0025] {
+        for eps in [0.64, 0.04, 0.01, 0.0025] {
             let solved = solve_eps(&c.scene, eps);
             let truth = validation::true_error(&c.reference, &means(&solved));
             let estimate = solved.error_estimate.expect("estimated");

@@ -671,7 +671,8 @@ fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solu
 
 /// The error estimate of the leaf-resolution solution `sol` (see [`solve::richardson_estimate`]):
 /// the same links solved on the mesh one and two levels coarser ([`solve::Cut::coarsened`]), the
-/// Richardson extrapolation of the three, with the visibility-sampling noise
+/// Richardson extrapolation of the three plus what polygons left whole hide from it
+/// ([`solve::unresolved_polygons`]), with the visibility-sampling noise
 /// ([`solve::visibility_noise`]) where that is larger, times [`solve::ESTIMATE_SAFETY`].
 fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config, max_bytes: usize) -> f64 {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
@@ -683,7 +684,7 @@ fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, c
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
         means.push(crate::output::polygon_results(h, &coarse).into_iter().map(|r| r.b).collect());
     }
-    let mesh = solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]);
+    let mesh = solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
     let noise = solve::visibility_noise(h, links, &sol.radiosity, config.visibility.rays);
     solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
 }
