@@ -76,12 +76,25 @@ pub const ORDER_MIN: f64 = 0.5;
 /// Largest convergence order the Richardson estimate assumes.
 pub const ORDER_MAX: f64 = 2.0;
 
+/// The most the estimate takes of a polygon's change `|d₁|`, [`ESTIMATE_SAFETY`] included. Where
+/// the order is low or not regular yet ([`ORDER_MIN`], `1/(2^0.5 − 1)` = 2.41) the safety factor
+/// would make it 6.3: the lowest order and the margin for a misjudged one, both at once. On the
+/// validation scenes at eps 0.64 to 0.000625 (`examples/estimate_orders.rs`, 2026-12-04) the
+/// polygon with the largest true error had at most 3.05 times its change `|d₁|` (corner room, ρ
+/// 0.95, eps 0.64; where the mesh's error dominates: on CIE 5.8 visibility sampling's does, which
+/// [`visibility_noise`] covers); 3.5 keeps 15% above it, and the whole estimate stayed at 1.08 or
+/// more times the true error on every row. It makes the coarse levels' estimate 3 to 8 times the
+/// true error instead of 4 to 14 (Ward's room: 10.4% and 8.7% for 2.8% and 2.4%), so that a coarse
+/// target stops at a coarse level.
+pub const CHANGE_FACTOR_MAX: f64 = 3.5;
+
 /// The error of `fine` (polygon means), from the same solve on meshes two (`coarse`) and four
 /// (`coarser`) times coarser. For each non-emitting polygon and channel, the changes
 /// `d₁ = fine − coarse` and `d₂ = coarse − coarser` give the order `p = log₂(d₂ / d₁)` (within
 /// [`ORDER_MIN`, `ORDER_MAX`]; [`ORDER_MIN`] when the changes differ in sign, the convergence not
-/// yet regular) and the error still in `fine`, `|d₁| / (2^p − 1)`. The largest, relative to the
-/// largest non-emitting mean.
+/// yet regular) and the error still in `fine`, `|d₁| / (2^p − 1)` (at most
+/// [`CHANGE_FACTOR_MAX`] / [`ESTIMATE_SAFETY`] times `|d₁|`). The largest, relative to the largest
+/// non-emitting mean.
 #[must_use]
 pub fn richardson_estimate(emitting: &[bool], fine: &[[f64; 3]], coarse: &[[f64; 3]], coarser: &[[f64; 3]]) -> f64 {
     let all = emitting.iter().all(|&e| e);
@@ -97,7 +110,7 @@ pub fn richardson_estimate(emitting: &[bool], fine: &[[f64; 3]], coarse: &[[f64;
                 continue;
             }
             let order = if d2 / d1 > 1.0 { (d2 / d1).log2().clamp(ORDER_MIN, ORDER_MAX) } else { ORDER_MIN };
-            worst = worst.max(d1.abs() / (order.exp2() - 1.0));
+            worst = worst.max(d1.abs() * (1.0 / (order.exp2() - 1.0)).min(CHANGE_FACTOR_MAX / ESTIMATE_SAFETY));
         }
     }
     if top > 0.0 { worst / top } else { 0.0 }

@@ -452,8 +452,8 @@ impl LeafCoefficients {
                 receiver_total[k as usize] += area * c;
             }
         };
-        for i in 0..stored {
-            add_unknown(i, &|j| coef.get(start[i] + j));
+        for (i, w) in start.windows(2).enumerate() {
+            add_unknown(i, &|j| coef.get(w[0] + j));
         }
         let mut first = stored;
         let mut buffer = Vec::new();
