@@ -6,7 +6,7 @@ pub mod quadrature;
 
 pub use aabb::Aabb;
 pub use glam::DVec3;
-pub use polygon::{Poly, PolyKind};
+pub use polygon::{BACK_TO_BACK_REL_TOL, Poly, PolyKind};
 
 /// Relative tolerance under which a length is treated as zero, relative to the size of the object it belongs to.
 pub const REL_EPS: f64 = 1e-12;

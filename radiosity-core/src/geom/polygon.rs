@@ -6,6 +6,10 @@
 
 use glam::DVec3;
 
+/// Relative tolerance of [`Poly::is_back_of`]: how far apart (relative to the polygon's size) the
+/// centroids of the two sides may be, and how far their areas (relative to the area).
+pub const BACK_TO_BACK_REL_TOL: f64 = 1e-9;
+
 /// Triangle or quad.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PolyKind {
@@ -50,6 +54,26 @@ impl Poly {
     #[must_use]
     pub fn vertices(&self) -> &[DVec3] {
         &self.v[..self.n_vertices()]
+    }
+
+    /// The polygon with its vertex order reversed (the back side becomes the front).
+    #[must_use]
+    pub fn reversed(&self) -> Poly {
+        let v = self.vertices();
+        match v.len() {
+            3 => Poly::triangle(v[2], v[1], v[0]),
+            _ => Poly::quad(v[3], v[2], v[1], v[0]),
+        }
+    }
+
+    /// Whether `other` is this polygon's back: the same outline facing the other way (same centroid
+    /// and area within [`BACK_TO_BACK_REL_TOL`], opposite normals), as a leaf's two faces are.
+    #[must_use]
+    pub fn is_back_of(&self, other: &Poly) -> bool {
+        let size = self.area().sqrt().max(f64::MIN_POSITIVE);
+        (self.centroid() - other.centroid()).length() <= BACK_TO_BACK_REL_TOL * size
+            && (self.area() - other.area()).abs() <= BACK_TO_BACK_REL_TOL * self.area()
+            && self.normal().dot(other.normal()) < 0.0
     }
 
     /// Area vector (normal times area), by Newell's method.

@@ -22,7 +22,7 @@ impl Default for BuildConfig {
 
 /// Relative tolerance of [`twins`]: how far apart (relative to the polygon's size) the centroids of
 /// the two sides may be.
-pub const TWIN_REL_TOL: f64 = 1e-9;
+pub const TWIN_REL_TOL: f64 = crate::geom::BACK_TO_BACK_REL_TOL;
 
 /// The two sides of every transmitting surface: consecutive polygons with the same reflectance and
 /// a positive transmittance (their materials may differ in emission), the second the first reversed
@@ -35,13 +35,7 @@ pub fn twins(scene: &Scene) -> Vec<u32> {
     while k + 1 < n {
         let (a, b) = (&scene.polygons[k], &scene.polygons[k + 1]);
         let (m, mb) = (&scene.materials[a.material as usize], &scene.materials[b.material as usize]);
-        let size = a.poly.area().sqrt();
-        if m.reflectance == mb.reflectance
-            && m.transmittance == mb.transmittance
-            && m.transmittance.iter().any(|&t| t > 0.0)
-            && (a.poly.centroid() - b.poly.centroid()).length() <= TWIN_REL_TOL * size.max(f64::MIN_POSITIVE)
-            && (a.poly.area() - b.poly.area()).abs() <= TWIN_REL_TOL * a.poly.area()
-            && a.poly.normal().dot(b.poly.normal()) < 0.0
+        if m.reflectance == mb.reflectance && m.transmittance == mb.transmittance && m.transmittance.iter().any(|&t| t > 0.0) && a.poly.is_back_of(&b.poly)
         {
             twin[k] = (k + 1) as u32;
             twin[k + 1] = k as u32;

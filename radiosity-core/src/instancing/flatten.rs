@@ -3,9 +3,9 @@
 //! flattened index of a polygon is known without flattening.
 
 use super::InstancingError;
-use super::model::{InstancedScene, PrototypeId, Transform};
+use super::model::{InstancedScene, LocalPolygon, PrototypeId, Transform};
 use crate::geom::Poly;
-use crate::scene::{Scene, SceneBuilder};
+use crate::scene::{Material, Scene, SceneBuilder};
 
 /// How polygons are emitted.
 #[derive(Clone, Copy, Debug)]
@@ -22,14 +22,32 @@ impl Default for FlattenOptions {
     }
 }
 
+/// Drops each polygon that is the back of the one before it (the same outline reversed, the same
+/// two-sided material): flattening gives every two-sided polygon its back
+/// ([`FlattenOptions::two_sided_pairs`]), so a leaf written as two back-to-back faces would
+/// otherwise become two leaves in one place, four sides, each lit and counted. Returns how many
+/// were dropped.
+pub fn merge_backs(polygons: &mut Vec<LocalPolygon>, materials: &[Material]) -> usize {
+    let before = polygons.len();
+    let mut kept: Vec<LocalPolygon> = Vec::with_capacity(before);
+    // Whether the last kept polygon already has its back merged (it is not a front for the next).
+    let mut paired = false;
+    for q in polygons.drain(..) {
+        let back = !paired
+            && kept.last().is_some_and(|p| p.material == q.material && materials[q.material as usize].two_sided && q.poly.is_back_of(&p.poly));
+        paired = back;
+        if !back {
+            kept.push(q);
+        }
+    }
+    *polygons = kept;
+    before - polygons.len()
+}
+
 /// The polygon with its vertex order reversed (the back side becomes the front).
 #[must_use]
 pub fn reversed(p: &Poly) -> Poly {
-    let v = p.vertices();
-    match v.len() {
-        3 => Poly::triangle(v[2], v[1], v[0]),
-        _ => Poly::quad(v[3], v[2], v[1], v[0]),
-    }
+    p.reversed()
 }
 
 /// Calls `f(poly, material, prototype)` for every polygon of prototype `id` placed by `transform`,

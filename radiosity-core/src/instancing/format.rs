@@ -492,6 +492,7 @@ impl Ctx<'_> {
             b.face(&vs, m, g, line)?;
         }
         out.polygons.extend(b.finish().polygons.iter().map(|p| LocalPolygon { poly: p.poly, material: p.material }));
+        super::flatten::merge_backs(&mut out.polygons, self.materials);
         for is in instances {
             let line = self.line(is.span().start);
             let s = is.get_ref();

@@ -162,6 +162,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
             return Err(SceneError::UnknownFormat { path: path.to_owned() });
         }
     };
+    let mut scene = scene;
+    scene.pair_two_sided();
     scene.check(path, options)?;
     Ok(scene)
 }
@@ -176,6 +178,37 @@ impl Scene {
             return Err(SceneError::NoEmitter { path: path.to_owned() });
         }
         Ok(())
+    }
+
+    /// Gives every two-sided polygon (a material that transmits, or is declared two-sided) its back,
+    /// right after it: the reversed polygon, unless the input already has it there (a leaf written
+    /// as two back-to-back faces). The solvers know one-sided surfaces; a pair with a transmittance
+    /// becomes one surface that transmits between its sides ([`crate::hierarchy::twins`]), and
+    /// without one, a face both of whose sides reflect. A lone face whose material transmits
+    /// would otherwise transmit nothing. Returns how many backs were added.
+    pub fn pair_two_sided(&mut self) -> usize {
+        let old = std::mem::take(&mut self.polygons);
+        let mut added = 0;
+        let mut i = 0;
+        while i < old.len() {
+            let p = old[i].clone();
+            self.polygons.push(p.clone());
+            i += 1;
+            if !self.materials[p.material as usize].two_sided {
+                continue;
+            }
+            match old.get(i) {
+                Some(q) if q.material == p.material && q.poly.is_back_of(&p.poly) => {
+                    self.polygons.push(q.clone());
+                    i += 1;
+                }
+                _ => {
+                    self.polygons.push(Polygon { poly: p.poly.reversed(), ..p });
+                    added += 1;
+                }
+            }
+        }
+        added
     }
 
     /// Bounding box of all polygons.

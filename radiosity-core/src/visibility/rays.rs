@@ -290,12 +290,25 @@ pub fn escape_fraction(h: &Hierarchy, caster: &RayCaster, seed: u64) -> f64 {
             let b = normal.cross(a);
             let dir = a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt();
             // A face in contact with another (a table leg's foot on the floor) sends nothing out:
-            // the ray would start beyond the surface it touches.
-            let in_contact = !caster.segment_clear_uncounted(p - normal * offset, p + normal * offset, poly, poly);
+            // the ray would start beyond the surface it touches. A face's own back (a leaf's other
+            // side, the polygon next to it) is not such a contact.
+            let back = back_of(h, poly).unwrap_or(poly);
+            let in_contact = !caster.segment_clear_uncounted(p - normal * offset, p + normal * offset, poly, back);
             !in_contact && caster.ray_clear_uncounted(p + normal * offset, dir)
         })
         .count();
     f64::from(escaped as u32) / f64::from(n)
+}
+
+/// The polygon next to `poly` (before or after it) that is its back ([`crate::geom::Poly::is_back_of`]):
+/// the other side of a two-sided surface, which [`crate::scene::Scene::pair_two_sided`] and
+/// flattening put next to each other.
+fn back_of(h: &Hierarchy, poly: u32) -> Option<u32> {
+    let front = h.get(poly).poly()?;
+    [poly.checked_sub(1), poly.checked_add(1).filter(|&q| q < h.n_polygons)]
+        .into_iter()
+        .flatten()
+        .find(|&q| h.get(q).poly().is_some_and(|b| b.is_back_of(front)))
 }
 
 /// Visibility between the surfaces of `source` and `receiver` from `config.rays` stratified
