@@ -104,3 +104,19 @@ fn an_obj_leaf_of_one_face_transmits_like_one_of_two() {
     }
     assert_eq!(outputs[0], outputs[1], "one face and two faces give the same leaf");
 }
+
+/// Two back-to-back faces of different materials stay two surfaces, each with its own back, and
+/// `stats.json` counts them with a message naming the file, the polygons and the materials.
+#[test]
+fn back_to_back_faces_of_different_materials_stay_apart_with_a_counted_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("leaf.mtl"), format!("{OBJ_MTL}newmtl other\nKd 0.3 0.3 0.3\nKt 0.2 0.2 0.2\n")).unwrap();
+    let obj = format!("{OBJ_GEOMETRY}o leaf\nusemtl leaf\nf 1 2 3 4\nusemtl other\nf 4 3 2 1\no ground\nusemtl ground\nf 5 6 7 8\no lamp\nusemtl lamp\nf 12 11 10 9\n");
+    std::fs::write(dir.path().join("leaf.obj"), obj).unwrap();
+    let (stats, csv) = solve(dir.path(), "leaf.obj");
+    assert_eq!(rows(&csv).len(), 6, "two faces with a back each, ground, lamp:\n{csv}");
+    let w = &stats["warnings"];
+    assert_eq!(w["unpaired_backs"], 1, "{w}");
+    let messages = w["messages"].as_array().unwrap();
+    assert!(messages.iter().any(|m| m.as_str().unwrap().contains("leaf.obj: polygon 1") && m.as_str().unwrap().contains("`other`")), "{w}");
+}

@@ -11,7 +11,7 @@ pub const PLANARITY_REL_TOL: f64 = 1e-6;
 /// Relative area under which a face is degenerate (area / longest edge² below this).
 pub const DEGENERATE_REL_AREA: f64 = 1e-14;
 /// How many warning messages are kept in words.
-const MAX_WARNING_MESSAGES: usize = 20;
+pub(super) const MAX_WARNING_MESSAGES: usize = 20;
 
 /// Builds a [`Scene`] face by face, repairing what can be repaired and counting it.
 pub struct SceneBuilder {

@@ -94,6 +94,9 @@ pub struct SceneWarnings {
     pub triangulated_faces: usize,
     /// Materials whose reflectance was clamped below 1 (formats whose total reflectance may reach 1).
     pub clamped_materials: usize,
+    /// Faces back to back with the two-sided face before them but of another material: kept as
+    /// two surfaces, each with its own back ([`Scene::pair_two_sided`]).
+    pub unpaired_backs: usize,
     /// The first few warnings in words (file:line: reason).
     pub messages: Vec<String>,
 }
@@ -107,6 +110,7 @@ impl SceneWarnings {
             (self.degenerate_faces, "degenerate face", "skipped"),
             (self.triangulated_faces, "face", "triangulated"),
             (self.clamped_materials, "material", "clamped"),
+            (self.unpaired_backs, "back-to-back face of another material", "kept as its own surface"),
         ]
         .into_iter()
         .filter(|&(n, ..)| n > 0)
@@ -202,7 +206,20 @@ impl Scene {
                     self.polygons.push(q.clone());
                     i += 1;
                 }
-                _ => {
+                next => {
+                    if let Some(q) = next.filter(|q| q.poly.is_back_of(&p.poly)) {
+                        self.warnings.unpaired_backs += 1;
+                        if self.warnings.messages.len() < builder::MAX_WARNING_MESSAGES {
+                            self.warnings.messages.push(format!(
+                                "{}: polygon {} (0-based, in input order) is back to back with polygon {} but of material `{}`, not `{}`: kept as two surfaces",
+                                self.name,
+                                i,
+                                i - 1,
+                                self.materials[q.material as usize].name,
+                                self.materials[p.material as usize].name
+                            ));
+                        }
+                    }
                     self.polygons.push(Polygon { poly: p.poly.reversed(), ..p });
                     added += 1;
                 }
@@ -265,7 +282,7 @@ mod tests {
     use super::SceneWarnings;
 
     fn summary(degenerate_faces: usize, triangulated_faces: usize, clamped_materials: usize) -> Option<String> {
-        SceneWarnings { degenerate_faces, triangulated_faces, clamped_materials, messages: Vec::new() }.summary()
+        SceneWarnings { degenerate_faces, triangulated_faces, clamped_materials, unpaired_backs: 0, messages: Vec::new() }.summary()
     }
 
     #[test]
