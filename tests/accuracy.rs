@@ -258,7 +258,8 @@ fn ward_room_points_within_two_percent_at_the_default_settings() {
 #[test]
 fn a_coarse_target_stops_at_a_coarse_level_and_meets_itself() {
     let c = case("ward-room");
-    let run = |target: f64| pipeline::run(&c.scene, &BfHand::default(), &Config { target_error: Some(target), ..Config::default() }, &|_| {});
+    let run =
+        |target: f64| pipeline::run(&c.scene, &BfHand::default(), &Config { target_error: Some(target), ..Config::default() }, &|_| {});
     let (coarse, fine) = (run(0.1), run(0.01));
     assert!(2 * coarse.links.len() < fine.links.len(), "{} links at 0.1, {} at 0.01", coarse.links.len(), fine.links.len());
     assert!(coarse.target_missed.is_none(), "{:?}", coarse.target_missed);

@@ -62,7 +62,9 @@ fn a_leaf_written_as_two_faces_or_one_is_one_leaf_with_two_sides() {
         assert_eq!(stats["closed"], false, "a lone leaf is open");
         for (b, band) in ["PAR", "NIR"].into_iter().enumerate() {
             let e = SUN_EN[b] * cos;
-            let close = |x: f64, want: f64, what: &str| assert!((x - want).abs() <= EXACT_TOL * want.abs().max(1.0), "{band} {what}: {x} against {want}");
+            let close = |x: f64, want: f64, what: &str| {
+                assert!((x - want).abs() <= EXACT_TOL * want.abs().max(1.0), "{band} {what}: {x} against {want}")
+            };
             close(num(&rows[0], &format!("h_{band}")), e, "front irradiance");
             close(num(&rows[1], &format!("h_{band}")), 0.0, "back irradiance");
             close(num(&rows[1], &format!("b_{band}")), tau[b] * e, "back radiosity");
@@ -78,7 +80,8 @@ fn a_leaf_written_as_two_faces_or_one_is_one_leaf_with_two_sides() {
     assert_eq!(outputs[0], outputs[1], "two faces and one face give the same leaf");
 }
 
-const OBJ_MTL: &str = "newmtl leaf\nKd 0.45 0.45 0.45\nKt 0.40 0.40 0.40\nnewmtl ground\nKd 0.25 0.25 0.25\nnewmtl lamp\nKd 0 0 0\nKe 100 100 100\n";
+const OBJ_MTL: &str =
+    "newmtl leaf\nKd 0.45 0.45 0.45\nKt 0.40 0.40 0.40\nnewmtl ground\nKd 0.25 0.25 0.25\nnewmtl lamp\nKd 0 0 0\nKe 100 100 100\n";
 const OBJ_GEOMETRY: &str = "mtllib leaf.mtl\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv -2 -2 0\nv 3 -2 0\nv 3 3 0\nv -2 3 0\n\
 v 0.4 0.4 2\nv 0.6 0.4 2\nv 0.6 0.6 2\nv 0.4 0.6 2\n";
 
@@ -92,7 +95,8 @@ fn an_obj_leaf_of_one_face_transmits_like_one_of_two() {
     for faces in ["f 1 2 3 4\n", "f 1 2 3 4\nf 4 3 2 1\n"] {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("leaf.mtl"), OBJ_MTL).unwrap();
-        let obj = format!("{OBJ_GEOMETRY}o leaf\nusemtl leaf\n{faces}o ground\nusemtl ground\nf 5 6 7 8\no lamp\nusemtl lamp\nf 12 11 10 9\n");
+        let obj =
+            format!("{OBJ_GEOMETRY}o leaf\nusemtl leaf\n{faces}o ground\nusemtl ground\nf 5 6 7 8\no lamp\nusemtl lamp\nf 12 11 10 9\n");
         std::fs::write(dir.path().join("leaf.obj"), obj).unwrap();
         let (_, csv) = solve(dir.path(), "leaf.obj");
         let rows = rows(&csv);
@@ -111,7 +115,9 @@ fn an_obj_leaf_of_one_face_transmits_like_one_of_two() {
 fn back_to_back_faces_of_different_materials_stay_apart_with_a_counted_warning() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("leaf.mtl"), format!("{OBJ_MTL}newmtl other\nKd 0.3 0.3 0.3\nKt 0.2 0.2 0.2\n")).unwrap();
-    let obj = format!("{OBJ_GEOMETRY}o leaf\nusemtl leaf\nf 1 2 3 4\nusemtl other\nf 4 3 2 1\no ground\nusemtl ground\nf 5 6 7 8\no lamp\nusemtl lamp\nf 12 11 10 9\n");
+    let obj = format!(
+        "{OBJ_GEOMETRY}o leaf\nusemtl leaf\nf 1 2 3 4\nusemtl other\nf 4 3 2 1\no ground\nusemtl ground\nf 5 6 7 8\no lamp\nusemtl lamp\nf 12 11 10 9\n"
+    );
     std::fs::write(dir.path().join("leaf.obj"), obj).unwrap();
     let (stats, csv) = solve(dir.path(), "leaf.obj");
     assert_eq!(rows(&csv).len(), 6, "two faces with a back each, ground, lamp:\n{csv}");

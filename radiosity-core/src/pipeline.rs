@@ -528,7 +528,8 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             finish_solve(&h, &links, sol, config, leaf_budget, closed, progress, passes, &mut leaf, config.stream_leaf_operator);
         if let Some(c) = leaf.as_ref().filter(|c| !c.is_complete()) {
             let share = c.recomputed_share();
-            let over = over_budget.get_or_insert(LeafOverBudget { levels: 0, recomputed_share: 0.0, budget_entries: usize::MAX, budget_bytes: 0 });
+            let over =
+                over_budget.get_or_insert(LeafOverBudget { levels: 0, recomputed_share: 0.0, budget_entries: usize::MAX, budget_bytes: 0 });
             over.levels += 1;
             over.recomputed_share = over.recomputed_share.max(share);
             let entries = leaf_budget / c.precision().bytes();
@@ -679,12 +680,14 @@ fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, c
     let mut means = vec![crate::output::polygon_results(h, sol).into_iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
-        let coefficients = solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error));
+        let coefficients =
+            solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error));
         let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
         means.push(crate::output::polygon_results(h, &coarse).into_iter().map(|r| r.b).collect());
     }
-    let mesh = solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
+    let mesh =
+        solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
     let noise = solve::visibility_noise(h, links, &sol.radiosity, config.visibility.rays);
     solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
 }

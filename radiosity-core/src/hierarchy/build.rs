@@ -35,7 +35,10 @@ pub fn twins(scene: &Scene) -> Vec<u32> {
     while k + 1 < n {
         let (a, b) = (&scene.polygons[k], &scene.polygons[k + 1]);
         let (m, mb) = (&scene.materials[a.material as usize], &scene.materials[b.material as usize]);
-        if m.reflectance == mb.reflectance && m.transmittance == mb.transmittance && m.transmittance.iter().any(|&t| t > 0.0) && a.poly.is_back_of(&b.poly)
+        if m.reflectance == mb.reflectance
+            && m.transmittance == mb.transmittance
+            && m.transmittance.iter().any(|&t| t > 0.0)
+            && a.poly.is_back_of(&b.poly)
         {
             twin[k] = (k + 1) as u32;
             twin[k + 1] = k as u32;

@@ -34,7 +34,9 @@ pub fn merge_backs(polygons: &mut Vec<LocalPolygon>, materials: &[Material]) -> 
     let mut paired = false;
     for q in polygons.drain(..) {
         let back = !paired
-            && kept.last().is_some_and(|p| p.material == q.material && materials[q.material as usize].two_sided && q.poly.is_back_of(&p.poly));
+            && kept
+                .last()
+                .is_some_and(|p| p.material == q.material && materials[q.material as usize].two_sided && q.poly.is_back_of(&p.poly));
         paired = back;
         if !back {
             kept.push(q);
