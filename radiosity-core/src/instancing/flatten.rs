@@ -46,12 +46,6 @@ pub fn merge_backs(polygons: &mut Vec<LocalPolygon>, materials: &[Material]) -> 
     before - polygons.len()
 }
 
-/// The polygon with its vertex order reversed (the back side becomes the front).
-#[must_use]
-pub fn reversed(p: &Poly) -> Poly {
-    p.reversed()
-}
-
 /// Calls `f(poly, material, prototype)` for every polygon of prototype `id` placed by `transform`,
 /// in flattening order: own polygons first (each two-sided one followed by its back twin when
 /// `options.two_sided_pairs`), then each instance's polygons, recursively, depth-first.
@@ -69,7 +63,7 @@ pub fn for_each_polygon(
             let poly = t.poly(&q.poly);
             f(poly, q.material, pid);
             if options.two_sided_pairs && scene.materials[q.material as usize].two_sided {
-                f(reversed(&poly), q.material, pid);
+                f(poly.reversed(), q.material, pid);
             }
         }
         // Reverse push so the first instance is visited first.

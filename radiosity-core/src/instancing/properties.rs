@@ -477,7 +477,7 @@ fn radiosity_albedo(flat: &Scene, bounds: &Aabb, w: DVec3, _a_eff: f64, eps: f64
     for i in 0..n0 {
         let p = scene.polygons[i].clone();
         if scene.materials[p.material as usize].two_sided {
-            scene.polygons.push(Polygon { poly: super::flatten::reversed(&p.poly), ..p });
+            scene.polygons.push(Polygon { poly: p.poly.reversed(), ..p });
         }
     }
     let caster = RayCaster::new(&scene);

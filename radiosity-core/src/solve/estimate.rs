@@ -136,36 +136,42 @@ pub fn visibility_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine:
         }
         let sd = (l.vis * (1.0 - l.vis) / rays).sqrt() * l.ff;
         let b = radiosity[l.source as usize];
-        let r = h.get(l.receiver);
-        let mut add = |p: usize, share: f64| {
+        receiver_polygons(h, l.receiver, |p, share| {
             for c in 0..3 {
                 var[p][c] += (share * sd * b[c]).powi(2);
             }
-        };
-        match r.kind {
-            crate::hierarchy::ElementKind::Surface { polygon, .. } => add(polygon as usize, r.area / h.get(polygon).area),
-            crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
-                for &p in &h.cluster_polygons[poly_start as usize..poly_end as usize] {
-                    add(p as usize, 1.0);
-                }
+        });
+    }
+    NOISE_SIGMAS * worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * var[p][c].sqrt())
+}
+
+/// Calls `add(polygon, share)` for every polygon a link's `receiver` covers: a surface's own with
+/// its share of the polygon's area, every polygon of a cluster whole.
+fn receiver_polygons(h: &crate::hierarchy::Hierarchy, receiver: crate::hierarchy::ElementId, mut add: impl FnMut(usize, f64)) {
+    let r = h.get(receiver);
+    match r.kind {
+        crate::hierarchy::ElementKind::Surface { polygon, .. } => add(polygon as usize, r.area / h.get(polygon).area),
+        crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
+            for &p in &h.cluster_polygons[poly_start as usize..poly_end as usize] {
+                add(p as usize, 1.0);
             }
         }
     }
+}
+
+/// The largest `error(polygon, channel)` over the non-emitting polygons (every polygon in a
+/// furnace, where all emit), relative to the largest non-emitting polygon mean of `radiosity`.
+fn worst_relative(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], error: impl Fn(usize, usize) -> f64) -> f64 {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
     let all = emitting.iter().all(|&e| e);
-    let mut top = 0.0f64;
-    let mut worst = 0.0f64;
-    for p in 0..n {
-        if emitting[p] && !all {
-            continue;
-        }
-        let mean = radiosity[p];
+    let (mut top, mut worst) = (0.0f64, 0.0f64);
+    for p in (0..h.n_polygons as usize).filter(|&p| all || !emitting[p]) {
         for c in 0..3 {
-            top = top.max(mean[c]);
-            worst = worst.max(h.reflectance[p][c] * var[p][c].sqrt());
+            top = top.max(radiosity[p][c]);
+            worst = worst.max(error(p, c));
         }
     }
-    if top > 0.0 { NOISE_SIGMAS * worst / top } else { 0.0 }
+    if top > 0.0 { worst / top } else { 0.0 }
 }
 
 /// The error that polygons left whole put into the others' means, relative to the largest
@@ -223,32 +229,11 @@ pub fn unresolved_polygons(h: &crate::hierarchy::Hierarchy, links: &[crate::refi
         if s == [0.0; 3] {
             continue;
         }
-        let r = h.get(l.receiver);
-        let mut add = |q: usize, share: f64| {
+        receiver_polygons(h, l.receiver, |q, share| {
             for c in 0..3 {
                 err[q][c] += h.reflectance[q][c] * share * l.ff * l.vis * s[c];
             }
-        };
-        match r.kind {
-            crate::hierarchy::ElementKind::Surface { polygon, .. } => add(polygon as usize, r.area / h.get(polygon).area),
-            crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
-                for &q in &h.cluster_polygons[poly_start as usize..poly_end as usize] {
-                    add(q as usize, 1.0);
-                }
-            }
-        }
+        });
     }
-    let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
-    let all = emitting.iter().all(|&e| e);
-    let (mut top, mut worst) = (0.0f64, 0.0f64);
-    for q in 0..n {
-        if emitting[q] && !all {
-            continue;
-        }
-        for c in 0..3 {
-            top = top.max(radiosity[q][c]);
-            worst = worst.max(err[q][c]);
-        }
-    }
-    if top > 0.0 { worst / top } else { 0.0 }
+    worst_relative(h, radiosity, |q, c| err[q][c])
 }

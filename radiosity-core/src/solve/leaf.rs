@@ -25,7 +25,8 @@
 //! and the other side scaled to it.
 //!
 //! The operator is solved to convergence with GMRES, starting from the hierarchical solution. It
-//! stores one `f32` coefficient per (leaf, chain link), in chain order (the link is implied), and
+//! stores one coefficient per (leaf, chain link) in a [`Precision`] (`f32`, or 16 bits for a target
+//! error of [`HALF_MIN_TARGET`] or coarser), in chain order (the link is implied), and
 //! one weight per (link source, leaf below it); beyond a budget of coefficients the remaining
 //! leaves' coefficients are computed again at every application, so that a budget costs time but
 //! never changes the answer.

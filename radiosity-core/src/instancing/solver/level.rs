@@ -11,7 +11,6 @@ use crate::geom::Poly;
 use crate::hierarchy::Hierarchy;
 use crate::instancing::InstancingError;
 use crate::instancing::face_transfer::BOX_FACES;
-use crate::instancing::flatten::reversed;
 use crate::instancing::model::{InstancedScene, PrototypeId};
 use crate::pipeline;
 use crate::refine::{ClassicBf, Link, first_guess_max};
@@ -111,7 +110,7 @@ pub(super) fn build_level(
         let k = k - task.flat_base;
         add(&mut b, &mut roles, &poly, material, Role::Own(PolygonInfo { flat_index: k, material, prototype }))?;
         if scene.materials[material as usize].two_sided {
-            add(&mut b, &mut roles, &reversed(&poly), material, Role::Own(PolygonInfo { flat_index: k + 1, material, prototype }))?;
+            add(&mut b, &mut roles, &poly.reversed(), material, Role::Own(PolygonInfo { flat_index: k + 1, material, prototype }))?;
         }
     }
     let directional = config.proxy_emission == ProxyEmission::Directional;
