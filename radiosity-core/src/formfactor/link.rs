@@ -176,13 +176,18 @@ pub const ON_PLANE_REL_TOL: f64 = 1e-9;
 /// ([`crate::refine::LinkCtx::facing`]) and of [`link_form_factor`].
 #[must_use]
 pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) -> bool {
-    let origin = match plane.poly() {
-        Some(p) => p.v[0],
+    let (origin, flatness) = match plane.poly() {
+        // A quad is planar only up to the loaders' tolerance (its vertices as written, rounded
+        // to a few decimals): a point counts as on its plane as long as it is no farther from it
+        // than the quad's own vertices are, or a face's own back (the same vertices) would be
+        // taken for a surface in front of it, at distance 0, and the two would exchange all their
+        // light (a form factor clamped to 1 each way: light out of nothing).
+        Some(p) => (p.v[0], p.vertices().iter().map(|&v| plane.normal.dot(v - p.v[0]).abs()).fold(0.0, f64::max)),
         // A flat cluster (all its polygons in one plane, one way) has its centre in that plane.
-        None if plane.normal != DVec3::ZERO => plane.center,
+        None if plane.normal != DVec3::ZERO => (plane.center, 0.0),
         None => return false,
     };
-    let tol = ON_PLANE_REL_TOL * plane.radius;
+    let tol = (ON_PLANE_REL_TOL * plane.radius).max(flatness);
     points.into_iter().all(|v| plane.normal.dot(v - origin) <= tol)
 }
 

@@ -7,7 +7,7 @@
 use glam::DVec3;
 
 /// Relative tolerance of [`Poly::is_back_of`]: how far apart (relative to the polygon's size) the
-/// centroids of the two sides may be, and how far their areas (relative to the area).
+/// matching vertices of the two sides may be.
 pub const BACK_TO_BACK_REL_TOL: f64 = 1e-9;
 
 /// Triangle or quad.
@@ -66,14 +66,22 @@ impl Poly {
         }
     }
 
-    /// Whether `other` is this polygon's back: the same outline facing the other way (same centroid
-    /// and area within [`BACK_TO_BACK_REL_TOL`], opposite normals), as a leaf's two faces are.
+    /// Whether `other` is this polygon's back: the same outline facing the other way (its vertices
+    /// those of this polygon in reverse order, from any start, each within [`BACK_TO_BACK_REL_TOL`]
+    /// of the polygon's size), as a leaf's two faces are. Vertices, not centroids and areas: a quad
+    /// written with a few decimals is planar only to its rounding, and then its two triangulations
+    /// (the front's and the reversed back's split along different diagonals) have centroids
+    /// 1e-10 m apart on a 10 cm leaf.
     #[must_use]
     pub fn is_back_of(&self, other: &Poly) -> bool {
-        let size = self.area().sqrt().max(f64::MIN_POSITIVE);
-        (self.centroid() - other.centroid()).length() <= BACK_TO_BACK_REL_TOL * size
-            && (self.area() - other.area()).abs() <= BACK_TO_BACK_REL_TOL * self.area()
-            && self.normal().dot(other.normal()) < 0.0
+        let (a, b) = (self.vertices(), other.vertices());
+        if a.len() != b.len() || self.normal().dot(other.normal()) >= 0.0 {
+            return false;
+        }
+        let scale = a.iter().map(|v| v.abs().max_element()).fold(0.0, f64::max);
+        let tol = BACK_TO_BACK_REL_TOL * self.area().sqrt() + 8.0 * f64::EPSILON * scale;
+        let n = a.len();
+        (0..n).any(|k| (0..n).all(|j| (b[j] - a[(k + n - j) % n]).length() <= tol))
     }
 
     /// Area vector (normal times area), by Newell's method.
