@@ -341,49 +341,209 @@ pub fn power_incident(h: &crate::hierarchy::Hierarchy) -> [f64; 3] {
     sum
 }
 
+/// Whether each polygon of `h` has an open back: one-sided (no back next to it, see
+/// [`crate::scene::Scene::pair_two_sided`]), so light reaching its back is blocked and lost, and
+/// not part of a closed mesh (every edge of its edge-connected faces shared by two of them, as
+/// a box's are), whose inside no light can reach. Light the solve puts on the backs of a closed
+/// mesh (a coarse element of the ground, half under a box, sending its mean radiosity from under
+/// it) is an error of the discretisation, left to show in the balance; light on an open back (a
+/// one-sided leaf) is lost for real, and counted.
+#[must_use]
+pub fn open_backs(h: &crate::hierarchy::Hierarchy) -> Vec<bool> {
+    let n = h.n_polygons as usize;
+    let key = |v: DVec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+    // Edges by their end points (exact: shared vertices are the same numbers), with the polygons
+    // that have them.
+    let mut edges: std::collections::HashMap<([u64; 3], [u64; 3]), Vec<u32>> = std::collections::HashMap::new();
+    for p in 0..n {
+        let Some(poly) = h.get(p as u32).poly() else { continue };
+        let vs = poly.vertices();
+        for k in 0..vs.len() {
+            let (a, b) = (key(vs[k]), key(vs[(k + 1) % vs.len()]));
+            edges.entry(if a <= b { (a, b) } else { (b, a) }).or_default().push(p as u32);
+        }
+    }
+    // Union-find over polygons sharing an edge.
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for polys in edges.values() {
+        for w in polys.windows(2) {
+            let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
+            parent[a.max(b) as usize] = a.min(b);
+        }
+    }
+    let mut open_component = vec![false; n];
+    for polys in edges.values() {
+        if polys.len() < 2 {
+            let r = root(&mut parent, polys[0]);
+            open_component[r as usize] = true;
+        }
+    }
+    (0..n)
+        .map(|p| {
+            let r = root(&mut parent, p as u32);
+            h.get(p as u32).poly().is_some() && crate::visibility::back_of(h, p as u32).is_none() && open_component[r as usize]
+        })
+        .collect()
+}
+
+/// Where the light leaving the surfaces goes besides the links, per channel (W): out of the scene,
+/// or onto an open back (see [`open_backs`]: blocked there, and lost), with that loss per polygon.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Leaving {
+    /// Leaving the scene.
+    pub escaped: [f64; 3],
+    /// Landing on the back of a one-sided face.
+    pub onto_backs: [f64; 3],
+    /// [`Leaving::onto_backs`] per polygon whose back it lands on, summed over channels (empty
+    /// when nothing lands on a back).
+    pub onto_backs_by_polygon: Vec<f64>,
+}
+
 /// Power (per channel) that leaves the scene: every surface leaf's `B·A` times its
 /// [`escape_fraction`], the [`ESCAPE_CELLS`] cells shared out over the leaf's quadrature points in
-/// turn. Independent of the links, so that `absorbed + escaped = incident + emitted` checks the
-/// solve.
+/// turn; and the power those cells' rays carry onto an open back (the closest
+/// hit's back, when `open_back` of its polygon, as [`open_backs`] gives it). Independent of the links, so that
+/// `absorbed + escaped + lost = incident + emitted` checks the solve.
 #[must_use]
-pub fn power_escaped(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster) -> [f64; 3] {
+pub fn power_leaving(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster, open_back: &[bool]) -> Leaving {
     use rayon::prelude::*;
     let cells = escape_cells();
     let diag = h.diagonal();
+    let offset = crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * diag;
+    let far = FAR_REL * diag;
+    let any_open_back = open_back.iter().any(|&o| o);
     let leaves: Vec<u32> = h.leaves().filter(|&l| h.get(l).polygon().is_some()).collect();
-    let per_leaf: Vec<[f64; 3]> = leaves
+    type PerLeaf = ([f64; 3], [f64; 3], Vec<(u32, f64)>);
+    let per_leaf: Vec<PerLeaf> = leaves
         .par_iter()
         .map(|&leaf| {
             let e = h.get(leaf);
             let b = radiosity[leaf as usize];
             if b.iter().all(|&v| v <= 0.0) {
-                return [0.0; 3];
+                return ([0.0; 3], [0.0; 3], Vec::new());
             }
-            let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return [0.0; 3] };
+            let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return ([0.0; 3], [0.0; 3], Vec::new()) };
             let rule = match poly.kind {
                 crate::geom::PolyKind::Quad => &crate::geom::quadrature::QUAD_9,
                 crate::geom::PolyKind::Triangle => &crate::geom::quadrature::TRI_6,
             };
             let points: Vec<DVec3> = crate::geom::quadrature::weighted_points(poly, rule).map(|(x, _)| x).collect();
-            let mut f = 0.0;
-            for (k, cell) in cells.iter().enumerate() {
-                let x = points[k % points.len()];
-                f += escape_fraction(caster, std::slice::from_ref(cell), x, e.normal, polygon, diag);
+            let frame = Site::new(e.normal, any_perpendicular(e.normal)).unwrap_or_default();
+            let (mut out, mut backs) = (0.0, Vec::new());
+            for (k, (d, w)) in cells.iter().enumerate() {
+                let origin = points[k % points.len()] + offset * e.normal;
+                let dir = frame.east() * d.x + frame.north * d.y + frame.up * d.z;
+                if caster.segment_clear(origin, origin + dir * far, polygon, NONE) {
+                    out += w;
+                } else if any_open_back
+                    && let Some((_, q)) = caster.closest_hit_where(origin, dir, |q| q != polygon)
+                    && open_back[q as usize]
+                    && h.get(q).normal.dot(dir) > 0.0
+                {
+                    backs.push((q, *w));
+                }
             }
-            b.map(|v| v * e.area * f)
+            let scale = b.map(|v| v * e.area);
+            let onto: f64 = backs.iter().map(|(_, w)| w).sum();
+            let total: f64 = scale.iter().sum();
+            (scale.map(|v| v * out), scale.map(|v| v * onto), backs.into_iter().map(|(q, w)| (q, w * total)).collect())
         })
         .collect();
     // Summed in leaf order: the same figure on every run.
-    per_leaf.iter().fold([0.0; 3], |a, b| std::array::from_fn(|c| a[c] + b[c]))
+    let mut leaving = Leaving::default();
+    for (esc, onto, by) in per_leaf {
+        for c in 0..3 {
+            leaving.escaped[c] += esc[c];
+            leaving.onto_backs[c] += onto[c];
+        }
+        for (q, v) in by {
+            if leaving.onto_backs_by_polygon.is_empty() {
+                leaving.onto_backs_by_polygon = vec![0.0; h.n_polygons as usize];
+            }
+            leaving.onto_backs_by_polygon[q as usize] += v;
+        }
+    }
+    leaving
+}
+
+/// Power (per channel) that leaves the scene (see [`power_leaving`]).
+#[must_use]
+pub fn power_escaped(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster) -> [f64; 3] {
+    power_leaving(h, radiosity, caster, &vec![false; h.n_polygons as usize]).escaped
+}
+
+/// Power (per channel) that the distant sources deliver to open backs ([`open_backs`]; `Σ A·E`
+/// over their leaves, a shadow ray per quadrature point and source from the back), blocked there
+/// and lost; and that power per polygon, summed over channels (empty when none).
+#[must_use]
+pub fn power_incident_on_backs(h: &crate::hierarchy::Hierarchy, caster: &RayCaster, open_back: &[bool]) -> ([f64; 3], Vec<f64>) {
+    use rayon::prelude::*;
+    if h.distant.is_empty() || !open_back.iter().any(|&o| o) {
+        return ([0.0; 3], Vec::new());
+    }
+    let light = DistantLight::new(&h.distant, Some(caster), h.diagonal());
+    let leaves: Vec<u32> = h
+        .leaves()
+        .filter(|&l| {
+            let e = h.get(l);
+            e.polygon().is_some_and(|p| open_back[p as usize]) && h.distant.iter().any(|s| s.on(-e.normal).iter().any(|&v| v > 0.0))
+        })
+        .collect();
+    let per_leaf: Vec<(u32, [f64; 3])> = leaves
+        .par_iter()
+        .map(|&leaf| {
+            let e = h.get(leaf);
+            let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return (0, [0.0; 3]) };
+            let rule = match poly.kind {
+                crate::geom::PolyKind::Quad => &crate::geom::quadrature::QUAD_9,
+                crate::geom::PolyKind::Triangle => &crate::geom::quadrature::TRI_6,
+            };
+            let (mut sum, mut wsum) = ([0.0; 3], 0.0);
+            for (x, w) in crate::geom::quadrature::weighted_points(poly, rule) {
+                let v = light.at(x, -e.normal, polygon);
+                for c in 0..3 {
+                    sum[c] += w * v[c];
+                }
+                wsum += w;
+            }
+            (polygon, if wsum > 0.0 { sum.map(|v| v / wsum * e.area) } else { [0.0; 3] })
+        })
+        .collect();
+    let (mut total, mut by) = ([0.0; 3], Vec::new());
+    for (p, v) in per_leaf {
+        if v.iter().all(|&x| x <= 0.0) {
+            continue;
+        }
+        if by.is_empty() {
+            by = vec![0.0; h.n_polygons as usize];
+        }
+        by[p as usize] += v.iter().sum::<f64>();
+        for c in 0..3 {
+            total[c] += v[c];
+        }
+    }
+    (total, by)
 }
 
 /// How far the power balance of a solve is from closing (see
 /// [`crate::pipeline::LevelReport::balance_gap`]): `solution.irradiance` is what the links bring,
-/// without the direct light.
+/// without the direct light. Light landing on the back of a one-sided face (from the sources or
+/// the surfaces) counts as incident and lost, as in `stats.json`.
 #[must_use]
 pub fn balance_gap(h: &crate::hierarchy::Hierarchy, solution: &crate::solve::Solution, caster: &RayCaster) -> f64 {
-    let incident = power_incident(h);
-    let escaped = power_escaped(h, &solution.radiosity, caster);
+    let open_back = open_backs(h);
+    let (on_backs, _) = power_incident_on_backs(h, caster, &open_back);
+    let front = power_incident(h);
+    let incident: [f64; 3] = std::array::from_fn(|c| front[c] + on_backs[c]);
+    let leaving = power_leaving(h, &solution.radiosity, caster, &open_back);
+    let escaped: [f64; 3] = std::array::from_fn(|c| leaving.escaped[c] + leaving.onto_backs[c] + on_backs[c]);
     let (mut absorbed, mut emitted) = ([0.0; 3], [0.0; 3]);
     for leaf in h.leaves() {
         let e = h.get(leaf);
@@ -411,6 +571,40 @@ mod tests {
     use super::*;
 
     const TOL: f64 = 1e-12;
+
+    /// A closed box's faces have no open back (nothing reaches their insides); a lone face has;
+    /// a face with its back written after it has none (the back reflects).
+    #[test]
+    fn open_backs_are_one_sided_faces_of_open_meshes() {
+        use crate::scene::{Material, SceneBuilder};
+        let mut b = SceneBuilder::new(std::path::Path::new("test"), "test");
+        let m = b.material(Material::diffuse("grey", [0.5; 3])).unwrap();
+        let mut two = Material::diffuse("leaf", [0.4; 3]);
+        two.two_sided = true;
+        let leaf = b.material(two).unwrap();
+        let g = b.group("g");
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        // A unit cube, faces outward.
+        let cube = [
+            [c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
+            [c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
+            [c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
+            [c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)],
+            [c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
+            [c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
+        ];
+        for f in &cube {
+            b.face(f, m, g, 0).unwrap();
+        }
+        let lone = [c(3., 0., 1.), c(4., 0., 1.), c(4., 1., 1.), c(3., 1., 1.)];
+        b.face(&lone, m, g, 0).unwrap();
+        b.face(&lone.map(|v| v + DVec3::Z), leaf, g, 0).unwrap();
+        let mut scene = b.finish();
+        scene.pair_two_sided();
+        let h = crate::hierarchy::build(&scene, &crate::hierarchy::BuildConfig::default());
+        let open = open_backs(&h);
+        assert_eq!(open, [vec![false; 6], vec![true], vec![false, false]].concat());
+    }
 
     #[test]
     fn cells_have_equal_solid_angle_and_cover_the_hemisphere() {

@@ -451,8 +451,14 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
     let unit = s.units.power_label();
     match (s.power_incident, s.power_escaped) {
         (Some(incident), Some(escaped)) => {
+            let lost = s.power_lost_at_backs.unwrap_or(0.0);
+            let (lost_text, lost_sum) = if lost > 0.0 {
+                (format!(", lost at the backs of one-sided faces {lost:.6e} {unit}"), " + lost")
+            } else {
+                (String::new(), "")
+            };
             println!(
-                "power: incident {incident:.6e} {unit} (sun and sky), emitted {:.6e} {unit}, absorbed {:.6e} {unit}, escaped {escaped:.6e} {unit} (balance {:.5}: absorbed + escaped over incident + emitted)",
+                "power: incident {incident:.6e} {unit} (sun and sky), emitted {:.6e} {unit}, absorbed {:.6e} {unit}, escaped {escaped:.6e} {unit}{lost_text} (balance {:.5}: absorbed + escaped{lost_sum} over incident + emitted)",
                 s.power_emitted,
                 s.power_absorbed,
                 s.power_balance.unwrap_or(f64::NAN)
@@ -603,8 +609,13 @@ fn solve_instanced(
             .iter()
             .enumerate()
             .map(|(c, n)| {
-                let band =
-                    output::BandPower { emitted: b.emitted[c], incident: b.incident[c], absorbed: b.absorbed[c], escaped: b.escaped[c] };
+                let band = output::BandPower {
+                    emitted: b.emitted[c],
+                    incident: b.incident[c],
+                    absorbed: b.absorbed[c],
+                    escaped: b.escaped[c],
+                    lost_at_backs: 0.0,
+                };
                 (n.clone(), serde_json::to_value(band).expect("plain numbers"))
             })
             .collect();
@@ -613,6 +624,7 @@ fn solve_instanced(
             incident: b.incident[c],
             absorbed: b.absorbed[c],
             escaped: b.escaped[c],
+            lost_at_backs: 0.0,
         }));
         doc["power_emitted"] = serde_json::json!(combine(&b.emitted));
         doc["power_incident"] = serde_json::json!(combine(&b.incident));

@@ -93,6 +93,12 @@ pub struct Stats {
     /// Power leaving the scene (W; null without daylight; see [`crate::daylight::power_escaped`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub power_escaped: Option<f64>,
+    /// Power landing on the back of one-sided faces, blocked there and lost (W; null without
+    /// daylight; see [`BandPower::lost_at_backs`]): counted in `power_balance` beside `absorbed`
+    /// and `escaped`, and named in `solve_warnings` when above [`LOST_AT_BACKS_WARN_REL`] of
+    /// `incident`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub power_lost_at_backs: Option<f64>,
     /// The scene's bands, when it names them (else the channels are r, g, b).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub bands: Vec<String>,
@@ -155,14 +161,21 @@ pub struct BandPower {
     pub absorbed: f64,
     /// Leaving the scene.
     pub escaped: f64,
+    /// Landing on the back of a one-sided face, from the sun and sky (counted in `incident` too)
+    /// or from the surfaces: blocked there and lost (see [`crate::daylight::power_leaving`]).
+    pub lost_at_backs: f64,
 }
 
 impl BandPower {
-    /// `(absorbed + escaped) / (emitted + incident)` with daylight, else `absorbed / emitted`.
+    /// `(absorbed + escaped + lost_at_backs) / (emitted + incident)` with daylight, else
+    /// `absorbed / emitted`.
     #[must_use]
     pub fn balance(&self, daylight: bool) -> Option<f64> {
-        let (out, inp) =
-            if daylight { (self.absorbed + self.escaped, self.emitted + self.incident) } else { (self.absorbed, self.emitted) };
+        let (out, inp) = if daylight {
+            (self.absorbed + self.escaped + self.lost_at_backs, self.emitted + self.incident)
+        } else {
+            (self.absorbed, self.emitted)
+        };
         (inp > 0.0).then(|| out / inp)
     }
 
@@ -174,6 +187,7 @@ impl BandPower {
             incident: a.incident + b.incident,
             absorbed: a.absorbed + b.absorbed,
             escaped: a.escaped + b.escaped,
+            lost_at_backs: a.lost_at_backs + b.lost_at_backs,
         })
     }
 }
@@ -181,6 +195,13 @@ impl BandPower {
 /// The power of each channel of a solve (escape and incidence measured only with daylight).
 #[must_use]
 pub fn channel_powers(solved: &crate::pipeline::Solved) -> [BandPower; 3] {
+    channel_powers_and_losses(solved).0
+}
+
+/// [`channel_powers`], with the light lost at the backs of one-sided faces per polygon (W summed
+/// over channels; empty when none is lost).
+#[must_use]
+pub fn channel_powers_and_losses(solved: &crate::pipeline::Solved) -> ([BandPower; 3], Vec<f64>) {
     let h = &solved.hierarchy;
     let mut out = [BandPower::default(); 3];
     let lum: f64 = h.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum();
@@ -194,18 +215,67 @@ pub fn channel_powers(solved: &crate::pipeline::Solved) -> [BandPower; 3] {
             out[c].absorbed += e.area * (1.0 - rho[c] - t[c]) * hh[c];
         }
     }
+    let mut lost_by_polygon = Vec::new();
     if !h.distant.is_empty() {
+        let open_back = crate::daylight::open_backs(h);
         let incident = crate::daylight::power_incident(h);
-        let escaped = crate::daylight::power_escaped(h, &solved.solution.radiosity, &solved.caster);
+        let (on_backs, on_backs_by) = crate::daylight::power_incident_on_backs(h, &solved.caster, &open_back);
+        let leaving = crate::daylight::power_leaving(h, &solved.solution.radiosity, &solved.caster, &open_back);
         for c in 0..3 {
-            out[c].incident = incident[c];
-            out[c].escaped = escaped[c];
+            out[c].incident = incident[c] + on_backs[c];
+            out[c].escaped = leaving.escaped[c];
+            out[c].lost_at_backs = leaving.onto_backs[c] + on_backs[c];
+        }
+        for by in [on_backs_by, leaving.onto_backs_by_polygon] {
+            if lost_by_polygon.is_empty() {
+                lost_by_polygon = by;
+            } else {
+                for (sum, v) in lost_by_polygon.iter_mut().zip(by) {
+                    *sum += v;
+                }
+            }
         }
     }
     for o in &mut out {
         o.emitted += lum;
     }
-    out
+    (out, lost_by_polygon)
+}
+
+/// Share of the incident light (in any channel) landing on the backs of one-sided faces above
+/// which the solve warns, naming the faces.
+pub const LOST_AT_BACKS_WARN_REL: f64 = 1e-3;
+
+/// How many polygons the lost-at-backs warning names.
+const LOST_AT_BACKS_NAMED: usize = 5;
+
+/// The warning for light lost at the backs of one-sided faces (see [`BandPower::lost_at_backs`]),
+/// when above [`LOST_AT_BACKS_WARN_REL`] of the incident light in some channel: how much, and the
+/// polygons that take most of it.
+#[must_use]
+pub fn lost_at_backs_warning(scene: &crate::scene::Scene, per: &[BandPower], lost_by_polygon: &[f64]) -> Option<String> {
+    let share = per.iter().filter(|p| p.incident > 0.0).map(|p| p.lost_at_backs / p.incident).fold(0.0, f64::max);
+    if share <= LOST_AT_BACKS_WARN_REL {
+        return None;
+    }
+    let mut worst: Vec<usize> = (0..lost_by_polygon.len()).filter(|&p| lost_by_polygon[p] > 0.0).collect();
+    let faces = worst.len();
+    worst.sort_by(|&a, &b| lost_by_polygon[b].total_cmp(&lost_by_polygon[a]).then(a.cmp(&b)));
+    let named: Vec<String> = worst
+        .iter()
+        .take(LOST_AT_BACKS_NAMED)
+        .map(|&p| {
+            let polygon = &scene.polygons[p];
+            let group = scene.groups.get(polygon.group as usize).map_or("", String::as_str);
+            format!("{p} (group `{group}`, material `{}`)", scene.materials[polygon.material as usize].name)
+        })
+        .collect();
+    Some(format!(
+        "{}: {:.2}% of the incident light lands on the back of one-sided faces and is lost there ({faces} faces; most on polygons {}, 0-based in input order): give their material `two_sided = true` (OBJ: `two_sided 1` in the MTL) for a back that reflects like the front, or leave them one-sided where the backs are really hidden",
+        scene.name,
+        100.0 * share,
+        named.join(", ")
+    ))
 }
 
 /// One luminaire in `stats.json`.
@@ -306,6 +376,7 @@ impl Stats {
             power_balance: (power_emitted > 0.0).then(|| power_absorbed / power_emitted),
             power_incident: None,
             power_escaped: None,
+            power_lost_at_backs: None,
             bands: Vec::new(),
             power_by_band: None,
             sun: None,
@@ -332,8 +403,9 @@ impl Stats {
             grids: None,
         };
         if !h.distant.is_empty() {
-            let per = channel_powers(solved);
+            let (per, lost_by_polygon) = channel_powers_and_losses(solved);
             stats.set_band_powers(&crate::output::csv::RGB, &per, true);
+            stats.solve_warnings.extend(lost_at_backs_warning(scene, &per, &lost_by_polygon));
         }
         stats
     }
@@ -349,6 +421,7 @@ impl Stats {
         if daylight {
             self.power_incident = Some(total.incident * scale);
             self.power_escaped = Some(total.escaped * scale);
+            self.power_lost_at_backs = Some(total.lost_at_backs * scale);
         }
         self.power_balance = total.balance(daylight);
         self.power_by_band = Some(names.iter().map(|n| n.as_ref().to_owned()).zip(per.iter().copied()).collect());

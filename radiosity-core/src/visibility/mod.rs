@@ -10,6 +10,6 @@ pub mod shaft;
 
 pub(crate) use rays::BvhFrame;
 pub use rays::{
-    ESCAPE_SAMPLES, KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, escape_fraction,
-    sampled_visibility,
+    ESCAPE_SAMPLES, KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, back_of,
+    escape_fraction, sampled_visibility,
 };

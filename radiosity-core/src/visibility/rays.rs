@@ -303,7 +303,8 @@ pub fn escape_fraction(h: &Hierarchy, caster: &RayCaster, seed: u64) -> f64 {
 /// The polygon next to `poly` (before or after it) that is its back ([`crate::geom::Poly::is_back_of`]):
 /// the other side of a two-sided surface, which [`crate::scene::Scene::pair_two_sided`] and
 /// flattening put next to each other.
-fn back_of(h: &Hierarchy, poly: u32) -> Option<u32> {
+#[must_use]
+pub fn back_of(h: &Hierarchy, poly: u32) -> Option<u32> {
     let front = h.get(poly).poly()?;
     [poly.checked_sub(1), poly.checked_add(1).filter(|&q| q < h.n_polygons)]
         .into_iter()
