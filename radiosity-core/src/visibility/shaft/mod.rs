@@ -27,6 +27,7 @@ mod rays;
 
 pub use arena::{CandidateLists, CandidateRange};
 pub use build::{MAX_SIDE_PLANES, SHAFT_REL_TOL, Shaft, ShaftKind};
+pub use bvh::ObjectBvh;
 pub use classify::{GRAZE_REL_TOL, ShaftClass, ShaftVerdict, classify, classify_with, element_vertices, occludes, shaft_of};
 pub use cull::{may_intersect_aabb, may_intersect_obb};
 pub use merge::{COPLANAR_REL_TOL, MergedPlate};
