@@ -283,7 +283,7 @@ fn a_canopy_written_either_way_absorbs_the_same_and_balances() {
 fn light_on_the_back_of_a_one_sided_face_is_counted_as_lost_and_named() {
     let dir = tempfile::tempdir().unwrap();
     let scene = format!(
-        "{LEAF_MATERIAL}[[material]]\nname = \"plate\"\nreflectance = 0.5\n[[material]]\nname = \"ground\"\nreflectance = 0.0\n\
+        "{LEAF_MATERIAL}[[material]]\nname = \"plate\"\nreflectance = 0.5\ntwo_sided = false\n[[material]]\nname = \"ground\"\nreflectance = 0.0\n\
          [[polygon]]\nmaterial = \"ground\"\nvertices = [[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]]\n\
          [[polygon]]\nmaterial = \"plate\"\nvertices = [[-0.5, 0.5, 1], [0.5, 0.5, 1], [0.5, -0.5, 1], [-0.5, -0.5, 1]]\n\
          [sun]\ndirection = [{}, {}, {}]\ndirect_normal = [{}, {}]\n",
@@ -320,7 +320,8 @@ fn light_on_the_back_of_a_one_sided_face_is_counted_as_lost_and_named() {
 fn a_canopy_of_one_sided_leaves_counts_what_lands_on_their_backs() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("leaves.obj"), canopy_obj(200, 0.15, 2.5, 11, false)).unwrap();
-    std::fs::write(dir.path().join("canopy.toml"), canopy_scene("reflectance = [0.10, 0.45]", "[0.10, 0.25]", true)).unwrap();
+    std::fs::write(dir.path().join("canopy.toml"), canopy_scene("reflectance = [0.10, 0.45]\ntwo_sided = false", "[0.10, 0.25]", true))
+        .unwrap();
     let (stats, _) = solve(dir.path(), "canopy.toml");
     for band in ["PAR", "NIR"] {
         let p = &stats["power_by_band"][band];
@@ -442,4 +443,48 @@ fn a_leaf_over_a_black_ground_meets_its_closed_form() {
         let balance = (p["absorbed"].as_f64().unwrap() + p["escaped"].as_f64().unwrap()) / p["incident"].as_f64().unwrap();
         close(balance, 1.0, 1.0, "balance");
     }
+}
+
+/// Under the sun and sky, leaves written as one face each with a plain opaque material are
+/// two-sided by default, as Radiance and CARIBU take them: the test's canopy gives the same rows
+/// as with `two_sided = true`, and `stats.json` counts the backs given; `two_sided = false` keeps
+/// them one-sided; the ground, whose underside sees nothing, keeps one side. Before, such leaves
+/// blocked the light reaching their backs and lost it (46% less absorbed, in the issue's canopy).
+#[test]
+fn lone_faces_under_the_sky_are_two_sided_unless_declared_one_sided() {
+    let run = |leaf: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("leaves.obj"), canopy_obj(60, 0.15, 2.5, 5, false)).unwrap();
+        std::fs::write(dir.path().join("canopy.toml"), canopy_scene(leaf, "[0.10, 0.25]", true)).unwrap();
+        solve(dir.path(), "canopy.toml")
+    };
+    let (default_stats, default_rows) = run("reflectance = [0.10, 0.45]");
+    let (_, declared_rows) = run("reflectance = [0.10, 0.45]\ntwo_sided = true");
+    let (one_stats, one_rows) = run("reflectance = [0.10, 0.45]\ntwo_sided = false");
+    assert_eq!(rows(&default_rows).len(), 121, "a row per side and the ground");
+    assert_eq!(default_rows, declared_rows, "by default as declared two-sided");
+    assert_eq!(default_stats["warnings"]["two_sided_by_default"], 60);
+    assert_eq!(rows(&one_rows).len(), 61, "declared one-sided: a row per leaf and the ground");
+    assert_eq!(one_stats["warnings"]["two_sided_by_default"], 0);
+    assert!(one_stats["power_lost_at_backs"].as_f64().unwrap() > 0.0);
+}
+
+/// A material that transmits cannot be declared one-sided: a one-line error naming the file and
+/// the material, and a failing exit.
+#[test]
+fn a_transmitting_material_declared_one_sided_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = "[[material]]\nname = \"leaf\"\nreflectance = 0.4\ntransmittance = 0.3\ntwo_sided = false\n\
+                 [[polygon]]\nmaterial = \"leaf\"\nvertices = [[0,0,1],[1,0,1],[1,1,1],[0,1,1]]\n\
+                 [sun]\ndirection = [0, 0, -1]\ndirect_normal = 100\n";
+    std::fs::write(dir.path().join("bad.toml"), scene).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["solve", "bad.toml", "--quiet", "--no-image", "--out", "out"])
+        .current_dir(dir.path())
+        .output()
+        .expect("the binary runs");
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("bad.toml") && stderr.contains("`leaf`") && stderr.contains("one-sided"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
 }

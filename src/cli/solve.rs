@@ -186,6 +186,8 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             plain.luminaires = lighting.luminaires;
             plain.units = lighting.units;
             plain.distant = lighting.bands.pack_distant(0);
+            // Under the sun and sky a lone face whose back can receive light is two-sided.
+            radiosity::daylight::two_sided_where_backs_see_light(&mut plain);
             if lighting.bands.declared || lighting.bands.has_daylight() {
                 bands = Some(lighting.bands);
             }

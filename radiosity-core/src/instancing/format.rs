@@ -65,9 +65,11 @@ pub struct MaterialSpec {
     /// Emitted radiosity, W/m².
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<ColorSpec>,
-    /// Both sides reflect (a side's radiosity is ρ·H(same side) + t·H(other side)).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub two_sided: bool,
+    /// Both sides reflect (a side's radiosity is ρ·H(same side) + t·H(other side)); `false`
+    /// declares the material one-sided, which a face under the sun and sky otherwise is only
+    /// where no light can reach its back ([`crate::scene::Scene::two_sided_where_backs_see_light`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub two_sided: Option<bool>,
 }
 
 /// A uniform or per-axis scale.
@@ -297,7 +299,8 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
             reflectance: ms.reflectance.rgb(),
             emission: ms.emission.as_ref().map_or([0.0; 3], ColorSpec::rgb),
             transmittance: ms.transmittance.as_ref().map_or([0.0; 3], ColorSpec::rgb),
-            two_sided: ms.two_sided,
+            two_sided: ms.two_sided == Some(true),
+            one_sided: ms.two_sided == Some(false),
         };
         seen.push(&ms.name);
         let _ = validator.material(mat).map_err(|e| InstancingError::at(path, line, e.to_string()))?;

@@ -42,7 +42,13 @@ pub fn write_scene(scene: &InstancedScene, dir: &Path, stem: &str) -> Result<Pat
             reflectance: ColorSpec::Rgb(m.reflectance),
             transmittance: m.transmittance.iter().any(|&t| t > 0.0).then_some(ColorSpec::Rgb(m.transmittance)),
             emission: m.emission.iter().any(|&e| e > 0.0).then_some(ColorSpec::Rgb(m.emission)),
-            two_sided: m.two_sided,
+            two_sided: if m.two_sided {
+                Some(true)
+            } else if m.one_sided {
+                Some(false)
+            } else {
+                None
+            },
         })
         .collect();
     let mut prototype = Vec::with_capacity(scene.prototypes.len());

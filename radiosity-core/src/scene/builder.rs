@@ -64,6 +64,11 @@ impl SceneBuilder {
             }
         }
         if m.transmittance.iter().any(|&t| t > 0.0) {
+            if m.one_sided {
+                return Err(bad(
+                    "declared one-sided (`two_sided = false`) but transmits: light would go through to a back it does not have".into(),
+                ));
+            }
             m.two_sided = true;
         }
         let i = self.scene.materials.len() as u32;

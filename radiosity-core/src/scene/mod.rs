@@ -31,13 +31,16 @@ pub struct Material {
     pub transmittance: [f64; 3],
     /// Whether both sides of the surface interact with light.
     pub two_sided: bool,
+    /// Declared one-sided (`two_sided = false`): never given a back by default (see
+    /// [`Scene::two_sided_where_backs_see_light`]).
+    pub one_sided: bool,
 }
 
 impl Material {
     /// A grey, non-emitting, one-sided material.
     #[must_use]
     pub fn diffuse(name: &str, reflectance: [f64; 3]) -> Material {
-        Material { name: name.to_owned(), reflectance, emission: [0.0; 3], transmittance: [0.0; 3], two_sided: false }
+        Material { name: name.to_owned(), reflectance, emission: [0.0; 3], transmittance: [0.0; 3], two_sided: false, one_sided: false }
     }
 
     /// True when some channel emits.
@@ -97,6 +100,9 @@ pub struct SceneWarnings {
     /// Faces back to back with the two-sided face before them but of another material: kept as
     /// two surfaces, each with its own back ([`Scene::pair_two_sided`]).
     pub unpaired_backs: usize,
+    /// One-sided faces of open meshes whose backs can receive light under the sun and sky, given
+    /// a back of their material, as a leaf has ([`crate::daylight::two_sided_where_backs_see_light`]).
+    pub two_sided_by_default: usize,
     /// The first few warnings in words (file:line: reason).
     pub messages: Vec<String>,
 }
@@ -111,6 +117,11 @@ impl SceneWarnings {
             (self.triangulated_faces, "face", "triangulated"),
             (self.clamped_materials, "material", "clamped"),
             (self.unpaired_backs, "back-to-back face of another material", "kept as its own surface"),
+            (
+                self.two_sided_by_default,
+                "lone face",
+                "given a back like its front, as light can reach it there (`two_sided = false` keeps a material one-sided)",
+            ),
         ]
         .into_iter()
         .filter(|&(n, ..)| n > 0)
@@ -282,7 +293,15 @@ mod tests {
     use super::SceneWarnings;
 
     fn summary(degenerate_faces: usize, triangulated_faces: usize, clamped_materials: usize) -> Option<String> {
-        SceneWarnings { degenerate_faces, triangulated_faces, clamped_materials, unpaired_backs: 0, messages: Vec::new() }.summary()
+        SceneWarnings {
+            degenerate_faces,
+            triangulated_faces,
+            clamped_materials,
+            unpaired_backs: 0,
+            two_sided_by_default: 0,
+            messages: Vec::new(),
+        }
+        .summary()
     }
 
     #[test]

@@ -120,8 +120,10 @@ fn convert_material(m: &tobj::Material, path: &Path) -> Result<Material, SceneEr
             }
         };
     }
-    if m.unknown_param.get("two_sided").is_some_and(|v| v.trim() == "1") {
-        out.two_sided = true;
+    match m.unknown_param.get("two_sided").map(|v| v.trim()) {
+        Some("1") => out.two_sided = true,
+        Some("0") => out.one_sided = true,
+        _ => {}
     }
     Ok(out)
 }

@@ -73,6 +73,7 @@ impl MaterialCtx {
             emission: scaled(self.ed),
             transmittance: td,
             two_sided: !force_one_sided && !self.one_sided,
+            one_sided: force_one_sided || self.one_sided,
         };
         (material, clamped)
     }
