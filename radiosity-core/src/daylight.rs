@@ -17,7 +17,7 @@
 //!
 //! Light enters the solve like the luminaires' (see [`crate::luminaire`]): each element's direct
 //! irradiance, a shadow ray per quadrature point and source, becomes the emission `ρ·E` of the
-//! radiosity system. Light that leaves the scene is measured after the solve ([`escape_fraction`]):
+//! radiosity system. Light that leaves the scene is measured after the solve ([`power_leaving`]):
 //! the power balance of an open scene is `incident = absorbed + escaped`.
 
 use crate::geom::DVec3;
@@ -290,30 +290,11 @@ impl<'a> DistantLight<'a> {
     }
 }
 
-/// Cells of the hemisphere about a surface's normal through which [`escape_fraction`] looks.
+/// Cells of the hemisphere about a surface's normal through which [`power_leaving`] looks.
 pub const ESCAPE_CELLS: u32 = 145;
 
-/// The fraction of the light leaving point `x` of polygon `skip` (normal `n`, diffusely) that
-/// leaves the scene: the cosine-weighted share of [`ESCAPE_CELLS`] equal-solid-angle cells of
-/// its hemisphere whose central ray hits nothing.
-#[must_use]
-pub fn escape_fraction(caster: &RayCaster, cells: &[(DVec3, f64)], x: DVec3, n: DVec3, skip: u32, scene_diagonal: f64) -> f64 {
-    let frame = Site::new(n, any_perpendicular(n)).unwrap_or_default();
-    let offset = crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * scene_diagonal;
-    let far = FAR_REL * scene_diagonal;
-    let origin = x + offset * n;
-    cells
-        .iter()
-        .filter(|(d, _)| {
-            let dir = frame.east() * d.x + frame.north * d.y + frame.up * d.z;
-            caster.segment_clear(origin, origin + dir * far, skip, NONE)
-        })
-        .map(|(_, w)| w)
-        .sum()
-}
-
 /// The [`ESCAPE_CELLS`] directions of a hemisphere about +z with their cosine weights (summing to
-/// 1), for [`escape_fraction`].
+/// 1), for [`power_leaving`].
 #[must_use]
 pub fn escape_cells() -> Vec<(DVec3, f64)> {
     let site = Site::default();
@@ -433,9 +414,9 @@ pub struct Leaving {
     pub onto_backs_by_polygon: Vec<f64>,
 }
 
-/// Power (per channel) that leaves the scene: every surface leaf's `B·A` times its
-/// [`escape_fraction`], the [`ESCAPE_CELLS`] cells shared out over the leaf's quadrature points in
-/// turn; and the power those cells' rays carry onto an open back (the closest
+/// Power (per channel) that leaves the scene: every surface leaf's `B·A` times the cosine-weighted
+/// share of the [`ESCAPE_CELLS`] cells of its hemisphere whose central ray hits nothing, the cells
+/// shared out over the leaf's quadrature points in turn; and the power those cells' rays carry onto an open back (the closest
 /// hit's back, when `open_back` of its polygon, as [`open_backs`] gives it). Independent of the links, so that
 /// `absorbed + escaped + lost = incident + emitted` checks the solve.
 #[must_use]
@@ -498,12 +479,6 @@ pub fn power_leaving(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], ca
         }
     }
     leaving
-}
-
-/// Power (per channel) that leaves the scene (see [`power_leaving`]).
-#[must_use]
-pub fn power_escaped(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster) -> [f64; 3] {
-    power_leaving(h, radiosity, caster, &vec![false; h.n_polygons as usize]).escaped
 }
 
 /// Power (per channel) that the distant sources deliver to open backs ([`open_backs`]; `Σ A·E`

@@ -389,7 +389,8 @@ pub fn update_direct(h: &mut Hierarchy, caster: Option<&RayCaster>) {
 }
 
 /// Points per side of the grid on which a sharp distant source's shadow boundary is sampled
-/// where it crosses an element (see [`boundary_correction`]).
+/// where it crosses an element (where the element's quadrature points disagree on the source's
+/// visibility).
 pub const SHADOW_BOUNDARY_GRID: u32 = 8;
 
 /// Where a sharp distant source's shadow boundary crosses a surface element (its rule's points

@@ -67,7 +67,7 @@ pub struct MaterialSpec {
     pub emission: Option<ColorSpec>,
     /// Both sides reflect (a side's radiosity is ρ·H(same side) + t·H(other side)); `false`
     /// declares the material one-sided, which a face under the sun and sky otherwise is only
-    /// where no light can reach its back ([`crate::scene::Scene::two_sided_where_backs_see_light`]).
+    /// where no light can reach its back ([`crate::daylight::two_sided_where_backs_see_light`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_sided: Option<bool>,
 }

@@ -90,13 +90,12 @@ pub struct Stats {
     /// mean as `power_absorbed`, or the sum over named bands).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub power_incident: Option<f64>,
-    /// Power leaving the scene (W; null without daylight; see [`crate::daylight::power_escaped`]).
+    /// Power leaving the scene (W; null without daylight; see [`crate::daylight::power_leaving`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub power_escaped: Option<f64>,
     /// Power landing on the back of one-sided faces, blocked there and lost (W; null without
     /// daylight; see [`BandPower::lost_at_backs`]): counted in `power_balance` beside `absorbed`
-    /// and `escaped`, and named in `solve_warnings` when above [`LOST_AT_BACKS_WARN_REL`] of
-    /// `incident`.
+    /// and `escaped`, and named in `solve_warnings` when above 0.1% of `incident`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub power_lost_at_backs: Option<f64>,
     /// The scene's bands, when it names them (else the channels are r, g, b).

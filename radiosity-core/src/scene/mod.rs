@@ -32,7 +32,7 @@ pub struct Material {
     /// Whether both sides of the surface interact with light.
     pub two_sided: bool,
     /// Declared one-sided (`two_sided = false`): never given a back by default (see
-    /// [`Scene::two_sided_where_backs_see_light`]).
+    /// [`crate::daylight::two_sided_where_backs_see_light`]).
     pub one_sided: bool,
 }
 

@@ -73,7 +73,10 @@ impl MaterialCtx {
             emission: scaled(self.ed),
             transmittance: td,
             two_sided: !force_one_sided && !self.one_sided,
-            one_sided: force_one_sided || self.one_sided,
+            // MGF's `sides 1` is a rendering hint, not a declaration against the default backs
+            // under the sun and sky (MGF scenes have none): its transmitting materials keep
+            // their backs as before.
+            one_sided: false,
         };
         (material, clamped)
     }
