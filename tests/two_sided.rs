@@ -343,8 +343,8 @@ fn a_canopy_of_one_sided_leaves_counts_what_lands_on_their_backs() {
 }
 
 /// The handbook form factor from a point to a parallel `a × b` rectangle at distance `c`, the
-/// point on the normal through one of its corners (Howell; `../shared/reference/formfactors.md`
-/// (a)).
+/// point on the normal through one of its corners (Howell, "A Catalog of Radiation Heat Transfer
+/// Configuration Factors": a differential area parallel to a rectangle, on the normal to a corner).
 fn corner_form_factor(a: f64, b: f64, c: f64) -> f64 {
     let (x, y) = (a / c, b / c);
     let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());

@@ -82,6 +82,12 @@ impl Site {
         self.north.cross(self.up)
     }
 
+    /// A direction given in the site's frame (x east, y north, z up) in the scene's frame.
+    #[must_use]
+    pub fn world(&self, d: DVec3) -> DVec3 {
+        self.east() * d.x + self.north * d.y + self.up * d.z
+    }
+
     /// The unit direction toward a point of the sky at zenith angle `zenith` and azimuth
     /// `azimuth` (radians, clockwise from north seen from above: east is π/2).
     #[must_use]
@@ -362,7 +368,7 @@ pub fn two_sided_where_backs_see_light(scene: &mut crate::scene::Scene) -> usize
             let frame = Site::new(back, any_perpendicular(back)).unwrap_or_default();
             let origin = polys[i].centroid() + offset * back;
             cells.iter().any(|(d, _)| {
-                let dir = frame.east() * d.x + frame.north * d.y + frame.up * d.z;
+                let dir = frame.world(*d);
                 caster.closest_hit_where(origin, dir, |q| q != i as u32).is_some()
             })
         })
@@ -438,16 +444,13 @@ pub fn power_leaving(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], ca
                 return ([0.0; 3], [0.0; 3], Vec::new());
             }
             let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return ([0.0; 3], [0.0; 3], Vec::new()) };
-            let rule = match poly.kind {
-                crate::geom::PolyKind::Quad => &crate::geom::quadrature::QUAD_9,
-                crate::geom::PolyKind::Triangle => &crate::geom::quadrature::TRI_6,
-            };
-            let points: Vec<DVec3> = crate::geom::quadrature::weighted_points(poly, rule).map(|(x, _)| x).collect();
+            let points: Vec<DVec3> =
+                crate::geom::quadrature::weighted_points(poly, crate::luminaire::element_rule(poly)).map(|(x, _)| x).collect();
             let frame = Site::new(e.normal, any_perpendicular(e.normal)).unwrap_or_default();
             let (mut out, mut backs) = (0.0, Vec::new());
             for (k, (d, w)) in cells.iter().enumerate() {
                 let origin = points[k % points.len()] + offset * e.normal;
-                let dir = frame.east() * d.x + frame.north * d.y + frame.up * d.z;
+                let dir = frame.world(*d);
                 if caster.segment_clear(origin, origin + dir * far, polygon, NONE) {
                     out += w;
                 } else if any_open_back
@@ -503,19 +506,7 @@ pub fn power_incident_on_backs(h: &crate::hierarchy::Hierarchy, caster: &RayCast
         .map(|&leaf| {
             let e = h.get(leaf);
             let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return (0, [0.0; 3]) };
-            let rule = match poly.kind {
-                crate::geom::PolyKind::Quad => &crate::geom::quadrature::QUAD_9,
-                crate::geom::PolyKind::Triangle => &crate::geom::quadrature::TRI_6,
-            };
-            let (mut sum, mut wsum) = ([0.0; 3], 0.0);
-            for (x, w) in crate::geom::quadrature::weighted_points(poly, rule) {
-                let v = light.at(x, -e.normal, polygon);
-                for c in 0..3 {
-                    sum[c] += w * v[c];
-                }
-                wsum += w;
-            }
-            (polygon, if wsum > 0.0 { sum.map(|v| v / wsum * e.area) } else { [0.0; 3] })
+            (polygon, crate::luminaire::element_mean3(poly, |x| light.at(x, -e.normal, polygon)).map(|v| v * e.area))
         })
         .collect();
     let (mut total, mut by) = ([0.0; 3], Vec::new());
@@ -534,18 +525,52 @@ pub fn power_incident_on_backs(h: &crate::hierarchy::Hierarchy, caster: &RayCast
     (total, by)
 }
 
+/// The light of a daylight solve measured apart from the links, per channel (W): what the sun and
+/// sky bring to either side of the surfaces, what leaves the scene, what lands on open backs
+/// ([`open_backs`]: from the sources and from the surfaces), and that loss per polygon (summed
+/// over channels; empty when none).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OutsideLinks {
+    /// Onto the surfaces from the distant sources, fronts and open backs.
+    pub incident: [f64; 3],
+    /// Out of the scene.
+    pub escaped: [f64; 3],
+    /// Onto open backs, blocked and lost.
+    pub lost_at_backs: [f64; 3],
+    /// [`OutsideLinks::lost_at_backs`] per polygon.
+    pub lost_by_polygon: Vec<f64>,
+}
+
+/// [`OutsideLinks`] of a solution: [`power_incident`], [`power_incident_on_backs`] and
+/// [`power_leaving`] together.
+#[must_use]
+pub fn outside_links(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster) -> OutsideLinks {
+    let open_back = open_backs(h);
+    let front = power_incident(h);
+    let (on_backs, on_backs_by) = power_incident_on_backs(h, caster, &open_back);
+    let leaving = power_leaving(h, radiosity, caster, &open_back);
+    let lost_by_polygon = match (on_backs_by.is_empty(), leaving.onto_backs_by_polygon.is_empty()) {
+        (true, _) => leaving.onto_backs_by_polygon,
+        (false, true) => on_backs_by,
+        (false, false) => on_backs_by.iter().zip(&leaving.onto_backs_by_polygon).map(|(a, b)| a + b).collect(),
+    };
+    OutsideLinks {
+        incident: std::array::from_fn(|c| front[c] + on_backs[c]),
+        escaped: leaving.escaped,
+        lost_at_backs: std::array::from_fn(|c| leaving.onto_backs[c] + on_backs[c]),
+        lost_by_polygon,
+    }
+}
+
 /// How far the power balance of a solve is from closing (see
 /// [`crate::pipeline::LevelReport::balance_gap`]): `solution.irradiance` is what the links bring,
 /// without the direct light. Light landing on the back of a one-sided face (from the sources or
 /// the surfaces) counts as incident and lost, as in `stats.json`.
 #[must_use]
 pub fn balance_gap(h: &crate::hierarchy::Hierarchy, solution: &crate::solve::Solution, caster: &RayCaster) -> f64 {
-    let open_back = open_backs(h);
-    let (on_backs, _) = power_incident_on_backs(h, caster, &open_back);
-    let front = power_incident(h);
-    let incident: [f64; 3] = std::array::from_fn(|c| front[c] + on_backs[c]);
-    let leaving = power_leaving(h, &solution.radiosity, caster, &open_back);
-    let escaped: [f64; 3] = std::array::from_fn(|c| leaving.escaped[c] + leaving.onto_backs[c] + on_backs[c]);
+    let outside = outside_links(h, &solution.radiosity, caster);
+    let incident = outside.incident;
+    let escaped: [f64; 3] = std::array::from_fn(|c| outside.escaped[c] + outside.lost_at_backs[c]);
     let (mut absorbed, mut emitted) = ([0.0; 3], [0.0; 3]);
     for leaf in h.leaves() {
         let e = h.get(leaf);

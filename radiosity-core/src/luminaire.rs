@@ -140,7 +140,7 @@ pub const MAX_SHADOW_DEPTH: u16 = 6;
 pub const SHADOW_ORIGIN_OFFSET_REL: f64 = 1e-5;
 
 /// The quadrature rule of a surface element: 9 points on quads, 6 on triangles.
-fn element_rule(poly: &crate::geom::Poly) -> &'static quadrature::Rule {
+pub(crate) fn element_rule(poly: &crate::geom::Poly) -> &'static quadrature::Rule {
     match poly.kind {
         PolyKind::Quad => &quadrature::QUAD_9,
         PolyKind::Triangle => &quadrature::TRI_6,
@@ -437,7 +437,7 @@ fn boundary_correction(poly: &crate::geom::Poly, lit: impl Fn(DVec3) -> bool) ->
 }
 
 /// The mean of `f` per channel over a surface element by its [`element_rule`].
-fn element_mean3(poly: &crate::geom::Poly, mut f: impl FnMut(DVec3) -> [f64; 3]) -> [f64; 3] {
+pub(crate) fn element_mean3(poly: &crate::geom::Poly, mut f: impl FnMut(DVec3) -> [f64; 3]) -> [f64; 3] {
     let (mut sum, mut wsum) = ([0.0; 3], 0.0);
     for (x, w) in quadrature::weighted_points(poly, element_rule(poly)) {
         let v = f(x);

@@ -216,24 +216,13 @@ pub fn channel_powers_and_losses(solved: &crate::pipeline::Solved) -> ([BandPowe
     }
     let mut lost_by_polygon = Vec::new();
     if !h.distant.is_empty() {
-        let open_back = crate::daylight::open_backs(h);
-        let incident = crate::daylight::power_incident(h);
-        let (on_backs, on_backs_by) = crate::daylight::power_incident_on_backs(h, &solved.caster, &open_back);
-        let leaving = crate::daylight::power_leaving(h, &solved.solution.radiosity, &solved.caster, &open_back);
+        let outside = crate::daylight::outside_links(h, &solved.solution.radiosity, &solved.caster);
         for c in 0..3 {
-            out[c].incident = incident[c] + on_backs[c];
-            out[c].escaped = leaving.escaped[c];
-            out[c].lost_at_backs = leaving.onto_backs[c] + on_backs[c];
+            out[c].incident = outside.incident[c];
+            out[c].escaped = outside.escaped[c];
+            out[c].lost_at_backs = outside.lost_at_backs[c];
         }
-        for by in [on_backs_by, leaving.onto_backs_by_polygon] {
-            if lost_by_polygon.is_empty() {
-                lost_by_polygon = by;
-            } else {
-                for (sum, v) in lost_by_polygon.iter_mut().zip(by) {
-                    *sum += v;
-                }
-            }
-        }
+        lost_by_polygon = outside.lost_by_polygon;
     }
     for o in &mut out {
         o.emitted += lum;
