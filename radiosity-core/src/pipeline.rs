@@ -434,6 +434,11 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let caster = RayCaster::new(scene);
     // Luminaires: surfaces split for their light, every element's direct illuminance.
     crate::luminaire::prepare(&mut h, config.use_visibility.then_some(&caster));
+    // Both sides of a transmitting leaf are cut into the same pieces (here and after every
+    // refinement), so each piece passes its light through to the piece behind it.
+    if !h.match_sides().is_empty() {
+        crate::luminaire::update_direct(&mut h, config.use_visibility.then_some(&caster));
+    }
     let shaft_objects = match effective_visibility(oracle, config.visibility_method) {
         VisibilityMethod::Shafts(volume) if use_visibility => Some(crate::visibility::shaft::ShaftObjects::new(
             scene,
@@ -495,6 +500,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
                 &|l, p| progress(Progress::Refine { level: level + 1, pass, links: l, pending: p }),
             );
             links = new_links;
+            for e in h.match_sides() {
+                data.inherit(&h, e);
+            }
             crate::luminaire::update_direct(&mut h, config.use_visibility.then_some(&caster));
             timings.refine += t.elapsed().as_secs_f64();
             stats.oracle_calls += s.oracle_calls;

@@ -18,6 +18,10 @@ pub type ElementId = u32;
 /// "No element".
 pub const NONE: ElementId = u32::MAX;
 
+/// Deepest surface element [`Hierarchy::mate`] follows to the other side (each level quarters the
+/// area: far below any [`BuildConfig::min_area_rel`]); deeper pieces take their ancestor's mate.
+pub const MAX_MATE_DEPTH: usize = 48;
+
 /// What an element is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ElementKind {
@@ -111,8 +115,9 @@ pub struct Hierarchy {
     /// Diffuse transmittance per input polygon (0 unless the polygon has a [`Hierarchy::twin`]).
     pub transmittance: Vec<[f64; 3]>,
     /// The other side of a two-sided, transmitting surface (the same polygon reversed, stored as
-    /// the next or previous input polygon), or [`NONE`]: a side's radiosity is
-    /// `E + ρ·H(this side) + t·H̄(other side)`, `H̄` the other side's mean irradiance.
+    /// the next or previous input polygon), or [`NONE`]: a piece of a side has the radiosity
+    /// `E + ρ·H(this side) + t·H(other side)`, the other side's irradiance at the same piece
+    /// ([`Hierarchy::mate`]).
     pub twin: Vec<u32>,
     /// Smallest area a surface element may be subdivided into.
     pub min_area: f64,
@@ -191,6 +196,82 @@ impl Hierarchy {
         true
     }
 
+    /// The piece of the other side that lies where surface element `id` lies, for a side of a
+    /// transmitting surface ([`Hierarchy::twin`]); [`NONE`] otherwise. Both sides split the same
+    /// vertices regularly, so their pieces coincide: the other side's piece at the same place and
+    /// depth, or its leaf there where that side is coarser ([`Hierarchy::match_sides`] keeps the
+    /// two alike). Light that one piece passes through reaches the other side at that piece only.
+    #[must_use]
+    pub fn mate(&self, id: ElementId) -> ElementId {
+        let Some(p) = self.get(id).polygon() else { return NONE };
+        let q = self.twin[p as usize];
+        if q == NONE {
+            return NONE;
+        }
+        // The path from the polygon's root down to `id`, followed on the other side.
+        let mut path = [NONE; MAX_MATE_DEPTH];
+        let mut depth = 0;
+        let mut a = id;
+        while usize::from(self.get(a).depth) > MAX_MATE_DEPTH {
+            a = self.get(a).parent;
+        }
+        while a != p && depth < MAX_MATE_DEPTH {
+            path[depth] = a;
+            depth += 1;
+            a = self.get(a).parent;
+        }
+        let mut b = q;
+        for &a in path[..depth].iter().rev() {
+            let Some(k) = self.piece_at(b, self.get(a).center) else { break };
+            b = k;
+        }
+        b
+    }
+
+    /// The child of `b` whose centre is nearest `x`, or `None` for a leaf.
+    fn piece_at(&self, b: ElementId, x: DVec3) -> Option<ElementId> {
+        self.children_of(b).iter().copied().min_by(|&u, &v| {
+            let (du, dv) = ((self.get(u).center - x).length_squared(), (self.get(v).center - x).length_squared());
+            du.total_cmp(&dv)
+        })
+    }
+
+    /// Subdivides each side of every transmitting surface wherever its other side is subdivided,
+    /// so that both sides are cut into the same pieces and each piece passes its light through to
+    /// its own [`Hierarchy::mate`]: one element with two sides. Returns the elements subdivided
+    /// (their children are new leaves, lit through their ancestors' links).
+    pub fn match_sides(&mut self) -> Vec<ElementId> {
+        let mut made = Vec::new();
+        let mut stack = Vec::new();
+        for p in 0..self.n_polygons {
+            let q = self.twin[p as usize];
+            if q == NONE || q < p {
+                continue;
+            }
+            stack.push((p, q));
+            while let Some((a, b)) = stack.pop() {
+                let (ka, kb) = (self.get(a).n_children, self.get(b).n_children);
+                if ka == 0 && kb == 0 {
+                    continue;
+                }
+                for (x, other) in [(a, kb), (b, ka)] {
+                    if other > 0 && self.get(x).n_children == 0 && self.subdivide(x) {
+                        made.push(x);
+                    }
+                }
+                if self.get(a).n_children == 0 || self.get(b).n_children == 0 {
+                    continue;
+                }
+                for &k in self.children_of(a) {
+                    if let Some(m) = self.piece_at(b, self.get(k).center) {
+                        stack.push((k, m));
+                    }
+                }
+            }
+        }
+        made
+    }
+
     /// Leaves (elements without children), in id order.
     pub fn leaves(&self) -> impl Iterator<Item = ElementId> + '_ {
         (0..self.elements.len() as ElementId).filter(|&i| self.elements[i as usize].n_children == 0)
@@ -198,7 +279,8 @@ impl Hierarchy {
 
     /// The emission of surface element `id` in the radiosity system: its polygon's own emission
     /// plus the reflection of the luminaires' direct light, `E + ρ·E_direct + t·Ē_direct(other
-    /// side)` (see [`crate::luminaire`]).
+    /// side)`, `Ē_direct` the other side's at the same piece ([`Hierarchy::mate`]; see
+    /// [`crate::luminaire`]).
     #[must_use]
     #[inline]
     pub fn emission_of(&self, id: ElementId) -> [f64; 3] {
@@ -209,8 +291,8 @@ impl Hierarchy {
             return own;
         }
         let d = self.direct.get(id as usize).copied().unwrap_or_default();
-        let twin = self.twin[p];
-        let other = if twin == NONE { [0.0; 3] } else { self.direct.get(twin as usize).copied().unwrap_or_default() };
+        let mate = self.mate(id);
+        let other = if mate == NONE { [0.0; 3] } else { self.direct.get(mate as usize).copied().unwrap_or_default() };
         std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d[c] + self.transmittance[p][c] * other[c])
     }
 
@@ -304,5 +386,63 @@ fn surface_element(polygon: u32, poly: Poly, normal: DVec3, parent: ElementId, d
         bounds,
         radius,
         depth,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, SceneBuilder};
+
+    /// A transmitting quad and a triangle, each with its back after it ([`Scene::pair_two_sided`]).
+    fn leaves() -> Hierarchy {
+        let mut b = SceneBuilder::new(std::path::Path::new("test"), "test");
+        let mut leaf = Material::diffuse("leaf", [0.4; 3]);
+        leaf.transmittance = [0.3; 3];
+        leaf.two_sided = true;
+        let m = b.material(leaf).unwrap();
+        let g = b.group("g");
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        b.face(&[c(0., 0., 0.), c(2., 0., 0.3), c(2., 1., 0.3), c(0., 1.5, 0.)], m, g, 0).unwrap();
+        b.face(&[c(3., 0., 0.), c(4., 0., 0.), c(3.5, 1., 0.5)], m, g, 0).unwrap();
+        let mut scene = b.finish();
+        scene.pair_two_sided();
+        let mut config = BuildConfig::default();
+        config.min_area_rel = 1e-4;
+        build(&scene, &config)
+    }
+
+    /// Both sides end up cut into the same pieces wherever either side was cut, and every piece's
+    /// mate lies where it lies, has its area, and has it for mate in turn.
+    #[test]
+    fn both_sides_are_cut_alike_and_every_piece_has_its_mate_behind_it() {
+        let mut h = leaves();
+        assert_eq!(h.twin[..4], [1, 0, 3, 2]);
+        // Cut the front of the quad two levels deep in one corner, the back of the triangle once.
+        h.subdivide(0);
+        let corner = h.children_of(0)[2];
+        h.subdivide(corner);
+        h.subdivide(3);
+        let leaves_of = |h: &Hierarchy, p: u32| h.leaves().filter(|&e| h.get(e).polygon() == Some(p)).count();
+        assert_eq!([leaves_of(&h, 0), leaves_of(&h, 1), leaves_of(&h, 2), leaves_of(&h, 3)], [7, 1, 1, 4]);
+        // Before matching, a piece on the uncut side's mate is that side's whole polygon.
+        assert_eq!(h.mate(corner), 1);
+        let made = h.match_sides();
+        assert_eq!(made.len(), 3, "the quad's back twice, the triangle's front once");
+        assert_eq!([leaves_of(&h, 0), leaves_of(&h, 1), leaves_of(&h, 2), leaves_of(&h, 3)], [7, 7, 4, 4]);
+        assert!(h.match_sides().is_empty(), "matching twice changes nothing");
+        for e in 0..h.len() as ElementId {
+            let el = h.get(e);
+            if el.is_cluster() {
+                continue;
+            }
+            let m = h.mate(e);
+            let other = h.get(m);
+            assert!((other.center - el.center).length() <= 1e-12, "{e} and its mate {m}");
+            assert!((other.area - el.area).abs() <= 1e-12 * el.area);
+            assert!(other.normal.dot(el.normal) < -0.999, "the mate faces the other way");
+            assert_eq!(h.mate(m), e);
+            assert_eq!(other.n_children, el.n_children);
+        }
     }
 }

@@ -18,8 +18,8 @@ pub struct Cut<'a> {
     /// Reflectance and emission per unknown, interleaved RGB.
     rho: Vec<f64>,
     emission: Vec<f64>,
-    /// Per unknown: transmittance and the other side's polygon (see [`Hierarchy::twin`]); empty
-    /// when nothing transmits.
+    /// Per unknown: transmittance and the other side's piece at the same place
+    /// ([`Hierarchy::mate`]); empty when nothing transmits.
     through: Vec<([f64; 3], ElementId)>,
 }
 
@@ -75,7 +75,7 @@ impl<'a> Cut<'a> {
             let p = h.get(e).polygon().expect("cut elements are surfaces") as usize;
             rho.extend_from_slice(&h.reflectance[p]);
             emission.extend_from_slice(&h.emission_of(e));
-            through.push((h.transmittance[p], h.twin[p]));
+            through.push((h.transmittance[p], h.mate(e)));
         }
         if through.iter().all(|(_, q)| *q == NONE) {
             through.clear();
@@ -153,7 +153,8 @@ impl<'a> Cut<'a> {
     }
 
     /// Adds `t·H̄(other side)` to every transmitting unknown's entry of `y`, for the unknowns'
-    /// irradiance `hs` (`H̄` the other side's area-weighted mean).
+    /// irradiance `hs` (`H̄` the mean over the other side's piece at the same place: its own
+    /// unknown's value below that side's cut).
     pub fn add_transmitted(&self, hs: &[[f64; 3]], y: &mut [f64]) {
         if self.through.is_empty() {
             return;

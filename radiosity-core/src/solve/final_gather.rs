@@ -39,7 +39,7 @@ pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (V
     for (&leaf, g) in leaves.iter().zip(gathered) {
         let p = h.get(leaf).polygon().expect("leaves are surfaces") as usize;
         // A transmitting side passes on the light of its other side.
-        let q = h.twin[p];
+        let q = h.mate(leaf);
         let through = if q == crate::hierarchy::NONE { [0.0; 3] } else { irr[q as usize] };
         let em = h.emission_of(leaf);
         b[leaf as usize] = std::array::from_fn(|c| em[c] + h.reflectance[p][c] * g[c] + h.transmittance[p][c] * through[c]);

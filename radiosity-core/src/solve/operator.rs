@@ -20,8 +20,8 @@ pub struct Operator<'a> {
     /// Leaf reflectance and emission, interleaved RGB.
     rho: Vec<f64>,
     emission: Vec<f64>,
-    /// Per leaf: transmittance and the other side's polygon (see [`Hierarchy::twin`]); empty when
-    /// no leaf transmits.
+    /// Per leaf: transmittance and the other side's piece at the same place ([`Hierarchy::mate`]);
+    /// empty when no leaf transmits.
     through: Vec<([f64; 3], ElementId)>,
     /// Scratch: per-element radiosity and irradiance (interior mutability avoided: rebuilt each call).
     n: usize,
@@ -70,7 +70,7 @@ impl<'a> Operator<'a> {
             .iter()
             .map(|&e| {
                 let p = h.get(e).polygon().expect("leaves are surfaces") as usize;
-                (h.transmittance[p], h.twin[p])
+                (h.transmittance[p], h.mate(e))
             })
             .collect();
         if through.iter().all(|(_, q)| *q == NONE) {
@@ -202,8 +202,8 @@ impl<'a> Operator<'a> {
     }
 
     /// Adds `t·H̄(other side)` to every transmitting leaf's entry of `y`, for leaf irradiance
-    /// `leaf_h` (leaf order; `H̄` the other side's area-weighted mean). Nothing when no leaf
-    /// transmits.
+    /// `leaf_h` (leaf order; `H̄` the area-weighted mean over the other side's piece at the same
+    /// place). Nothing when no leaf transmits.
     pub fn add_transmitted(&self, leaf_h: &[[f64; 3]], y: &mut [f64]) {
         if self.through.is_empty() {
             return;

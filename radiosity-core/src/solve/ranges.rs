@@ -103,8 +103,8 @@ fn leaf_range(h: &Hierarchy, index: &LinksByReceiver<'_>, sol: &Solution, leaf: 
     let (mut lo, mut hi) = (mean, mean);
     let (Some(poly), Some(p)) = (e.poly(), e.polygon()) else { return (lo, hi) };
     let p = p as usize;
-    let (rho, em, t, twin) = (h.reflectance[p], h.emission_of(leaf), h.transmittance[p], h.twin[p]);
-    let through = if twin == NONE { [0.0; 3] } else { sol.irradiance[twin as usize] };
+    let (rho, em, t, mate) = (h.reflectance[p], h.emission_of(leaf), h.transmittance[p], h.mate(leaf));
+    let through = if mate == NONE { [0.0; 3] } else { sol.irradiance[mate as usize] };
     let mut probes = [DVec3::ZERO; 5];
     probes[0] = e.center;
     let vs = poly.vertices();
