@@ -618,3 +618,29 @@ fn a_canopy_absorbs_what_an_independent_photon_tracer_finds() {
 
 /// How close the solver's absorbed power is to the photon tracer's (issue: within 1%).
 const PHOTON_TOL: f64 = 1e-2;
+
+/// A degenerate leaf (its vertices on a line, or repeated) in a scene file's OBJ or inline is
+/// skipped with a counted warning naming the file and line. Before, a scene file dropped it
+/// silently (the count stayed 0: the prototypes' readers' counts were thrown away).
+#[test]
+fn degenerate_leaves_are_skipped_with_a_warning_naming_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("leaves.obj"),
+        "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv 2 0 1\nusemtl leaf\nf 1 2 3 4\nf 1 2 5\nf 1 2 1\n",
+    )
+    .unwrap();
+    let scene = format!(
+        "obj = \"leaves.obj\"\n{LEAF_MATERIAL}[[polygon]]\nmaterial = \"leaf\"\nvertices = [[0,0,2],[1,0,2],[2,0,2]]\n\
+         [sun]\ndirection = [0, 0, -1]\ndirect_normal = [400, 380]\n"
+    );
+    std::fs::write(dir.path().join("leaves.toml"), scene).unwrap();
+    let (stats, csv) = solve(dir.path(), "leaves.toml");
+    assert_eq!(rows(&csv).len(), 2, "the one good leaf, two sides:\n{csv}");
+    let w = &stats["warnings"];
+    assert_eq!(w["degenerate_faces"], 3, "{w}");
+    let messages: Vec<&str> = w["messages"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+    for place in ["leaves.obj:8", "leaves.obj:9", "leaves.toml:7"] {
+        assert!(messages.iter().any(|m| m.contains(place) && m.contains("degenerate")), "{place} in {messages:?}");
+    }
+}

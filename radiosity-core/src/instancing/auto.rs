@@ -169,7 +169,7 @@ pub fn auto_instance(scene: &Scene, options: &AutoOptions) -> AutoResult {
             })
             .collect();
         let name = group_name(scene, rep.group);
-        prototypes.push(Prototype { name, polygons, instances: Vec::new(), source: None });
+        prototypes.push(Prototype { name, polygons, ..Prototype::default() });
         report.prototypes += 1;
         for (o_idx, r, map) in &class.members {
             let o = &objects[*o_idx];

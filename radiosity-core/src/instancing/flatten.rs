@@ -73,9 +73,14 @@ pub fn for_each_polygon(
     }
 }
 
-/// The whole scene as plain polygons (groups are prototype names).
+/// The whole scene as plain polygons (groups are prototype names), with what reading its files
+/// repaired or skipped ([`super::model::Prototype::warnings`]).
 pub fn flatten(scene: &InstancedScene, options: &FlattenOptions) -> Result<Scene, InstancingError> {
-    flatten_prototype(scene, scene.root, &Transform::IDENTITY, options)
+    let mut flat = flatten_prototype(scene, scene.root, &Transform::IDENTITY, options)?;
+    for p in &scene.prototypes {
+        flat.warnings.add(&p.warnings);
+    }
+    Ok(flat)
 }
 
 /// Prototype `id` placed by `transform`, as plain polygons.

@@ -465,6 +465,7 @@ impl Ctx<'_> {
                 out.polygons.push(LocalPolygon { poly: p.poly, material });
             }
             out.source = Some(PathBuf::from(obj.get_ref()));
+            out.warnings.add(&mesh.warnings);
         }
         // Inline geometry goes through the scene builder for validation and triangulation.
         let mut b = SceneBuilder::new(self.path, name);
@@ -494,7 +495,9 @@ impl Ctx<'_> {
             let vs: Vec<DVec3> = s.vertices.iter().map(|v| DVec3::from_array(*v)).collect();
             b.face(&vs, m, g, line)?;
         }
-        out.polygons.extend(b.finish().polygons.iter().map(|p| LocalPolygon { poly: p.poly, material: p.material }));
+        let inline = b.finish();
+        out.warnings.add(&inline.warnings);
+        out.polygons.extend(inline.polygons.iter().map(|p| LocalPolygon { poly: p.poly, material: p.material }));
         super::flatten::merge_backs(&mut out.polygons, self.materials);
         for is in instances {
             let line = self.line(is.span().start);

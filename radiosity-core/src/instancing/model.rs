@@ -158,6 +158,9 @@ pub struct Prototype {
     pub instances: Vec<Instance>,
     /// Where it came from (the OBJ file, or `None` when generated), for the writer and messages.
     pub source: Option<PathBuf>,
+    /// What reading it repaired or skipped (degenerate faces, triangulations), counted once per
+    /// face of the file, not per instance.
+    pub warnings: crate::scene::SceneWarnings,
 }
 
 /// A scene with instances. The scene itself is the prototype [`InstancedScene::root`].

@@ -223,7 +223,7 @@ impl PlantLibrary {
                 Poly::quad(c + DVec3::new(-s, -s, 0.0), c + DVec3::new(-s, s, 0.0), c + DVec3::new(s, s, 0.0), c + DVec3::new(s, -s, 0.0));
             polygons.push(LocalPolygon { poly, material: l });
         }
-        Prototype { name: "scene".into(), polygons, instances, source: None }
+        Prototype { name: "scene".into(), polygons, instances, ..Prototype::default() }
     }
 }
 

@@ -108,6 +108,17 @@ pub struct SceneWarnings {
 }
 
 impl SceneWarnings {
+    /// Adds `other`'s counts and as many of its messages as there is room for.
+    pub fn add(&mut self, other: &SceneWarnings) {
+        self.degenerate_faces += other.degenerate_faces;
+        self.triangulated_faces += other.triangulated_faces;
+        self.clamped_materials += other.clamped_materials;
+        self.unpaired_backs += other.unpaired_backs;
+        self.two_sided_by_default += other.two_sided_by_default;
+        let room = builder::MAX_WARNING_MESSAGES.saturating_sub(self.messages.len());
+        self.messages.extend(other.messages.iter().take(room).cloned());
+    }
+
     /// What was repaired or skipped, in words, the counts that are zero left out
     /// (`2 degenerate faces skipped, 1 face triangulated`); `None` when nothing was.
     #[must_use]
