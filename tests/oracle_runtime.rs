@@ -165,6 +165,7 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
         data: &data,
         threshold_scale: 1.0,
         shafts: None,
+        criterion: Default::default(),
     };
     // The energy part of BF: facing, transfer, subdivision; no visibility tool.
     let energy = GraphBuilder::new("energy")

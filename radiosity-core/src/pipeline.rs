@@ -40,6 +40,8 @@ pub struct Config {
     pub use_visibility: bool,
     /// How link visibility is computed.
     pub visibility_method: VisibilityMethod,
+    /// What the link criteria bound the error of (radiosity or irradiance).
+    pub criterion: refine::Criterion,
     /// Analyse the scene first and leave out what it does not need (visibility in a convex
     /// enclosure); see [`crate::analysis`].
     pub analyse: bool,
@@ -88,6 +90,7 @@ impl Default for Config {
             use_visibility: true,
             analyse: true,
             visibility_method: VisibilityMethod::Rays,
+            criterion: refine::Criterion::Radiosity,
             final_gather: true,
             leaf_operator_max_bytes: solve::LEAF_OPERATOR_MAX_BYTES,
             stream_leaf_operator: true,
@@ -497,6 +500,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
                 scale,
                 shafts,
                 limits,
+                config.criterion,
                 &|l, p| progress(Progress::Refine { level: level + 1, pass, links: l, pending: p }),
             );
             links = new_links;

@@ -109,6 +109,11 @@ pub struct CommonOptions {
     /// `hull` bounding volumes.
     #[arg(long, default_value = "rays", value_parser = ["rays", "aabb", "obb", "hull"])]
     pub visibility: String,
+    /// What the link criteria bound the error of: `radiosity` (B = E + ρH: a shadow within a
+    /// receiver counts in proportion to its reflectance) or `irradiance` (H, whatever the
+    /// reflectance: black sensors and dark floors refined like white walls).
+    #[arg(long, default_value = "radiosity", value_parser = ["radiosity", "irradiance"])]
+    pub criterion: String,
     /// Memory refinement may use, MB (default: half the machine's physical memory): beyond it no
     /// link is subdivided any more, and stats.json says so.
     #[arg(long, value_name = "MB")]
@@ -171,6 +176,8 @@ impl CommonOptions {
         // clap accepts only the names `VisibilityMethod::name` gives.
         use radiosity::pipeline::VisibilityMethod;
         config.visibility_method = VisibilityMethod::from_name(&self.visibility).unwrap_or(VisibilityMethod::Rays);
+        // clap accepts only the names `Criterion::name` gives.
+        config.criterion = radiosity::refine::Criterion::from_name(&self.criterion).unwrap_or_default();
         if let Some(mb) = self.max_memory {
             config.max_memory_bytes = (mb * 1e6) as usize;
         }

@@ -314,6 +314,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         "seed": args.options.common.seed,
         "min_area": args.options.common.min_area,
         "visibility": if args.options.common.no_visibility { "none" } else { config.visibility_method.name() },
+        "criterion": config.criterion.name(),
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     stats.target_error = config.target_error;

@@ -38,7 +38,15 @@ fn class_of(c: VisibilityClass) -> ReferenceClass {
 pub fn visibility_study(solved: &Solved, visibility: VisibilityConfig, thresholds: &[f64]) -> Vec<StudyRow> {
     let h = &solved.hierarchy;
     let data = crate::refine::ElementData::first_guess(h);
-    let services = Services { hierarchy: h, caster: Some(&solved.caster), visibility, data: &data, threshold_scale: 1.0, shafts: None };
+    let services = Services {
+        hierarchy: h,
+        caster: Some(&solved.caster),
+        visibility,
+        data: &data,
+        threshold_scale: 1.0,
+        shafts: None,
+        criterion: crate::refine::Criterion::default(),
+    };
     // Classify each link once; a fresh context per classifier so none reuses another's rays. Links
     // in parallel: each link's rays are seeded by the link, so the result does not depend on threads.
     let classified: Vec<(f64, ReferenceClass, [ReferenceClass; 3])> = solved

@@ -70,7 +70,7 @@ pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
             (false, true) => {}
         }
     }
-    let transfer = b * ctx.form_factor_max() * ctx.receiver_reflectance();
+    let transfer = b * ctx.form_factor_max() * ctx.receiver_weight();
     if 0.5 * transfer > threshold {
         let v = ctx.visibility(ctx.services.visibility.rays);
         if 2.0 * v * (1.0 - v) * transfer > threshold {

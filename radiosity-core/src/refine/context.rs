@@ -4,6 +4,38 @@ use crate::formfactor::{self, FormFactorQuality};
 use crate::hierarchy::{Element, Hierarchy};
 use crate::visibility::{RayCaster, VisibilityConfig};
 
+/// What the link criteria bound the error of, at each receiver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Criterion {
+    /// The radiosity `B = E + ρ·H`: how a shadow falls within a receiver counts in proportion to
+    /// its reflectance, so a black receiver's irradiance is never refined for a shadow.
+    #[default]
+    Radiosity,
+    /// The irradiance `H`, whatever the receiver's reflectance: a black sensor's penumbra is
+    /// refined like a white wall's (lux and absorbed power follow from `H`).
+    Irradiance,
+}
+
+impl Criterion {
+    /// Every criterion, in the order the CLI lists them.
+    pub const ALL: [Criterion; 2] = [Criterion::Radiosity, Criterion::Irradiance];
+
+    /// The name the CLI and `stats.json` use.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Criterion::Radiosity => "radiosity",
+            Criterion::Irradiance => "irradiance",
+        }
+    }
+
+    /// The criterion named `name`.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Criterion> {
+        Criterion::ALL.into_iter().find(|c| c.name() == name)
+    }
+}
+
 /// Read-only services shared by every link of a refinement pass.
 pub struct Services<'a> {
     /// The element arena.
@@ -21,6 +53,8 @@ pub struct Services<'a> {
     /// Shaft culling for visibility, when enabled: links are classified by their shafts first and
     /// rays are cast against the shaft's candidate occluders only.
     pub shafts: Option<ShaftServices<'a>>,
+    /// What the criteria bound the error of.
+    pub criterion: Criterion,
 }
 
 /// Shaft culling shared by a refinement pass.
@@ -351,6 +385,16 @@ impl<'a> LinkCtx<'a> {
             None => h.reflectance_of(self.receiver),
         };
         rho[0].max(rho[1]).max(rho[2])
+    }
+
+    /// How much an error in the distribution of the receiver's irradiance counts: its reflectance
+    /// under [`Criterion::Radiosity`] (the light it passes on), 1 under [`Criterion::Irradiance`].
+    #[must_use]
+    pub fn receiver_weight(&self) -> f64 {
+        match self.services.criterion {
+            Criterion::Radiosity => self.receiver_reflectance(),
+            Criterion::Irradiance => 1.0,
+        }
     }
 
     /// The irradiance a relative threshold on this link is measured against: the receiver's own

@@ -117,6 +117,7 @@ pub fn refine(
     threshold_scale: f64,
     shafts: Option<super::ShaftServices<'_>>,
     limits: RefineLimits,
+    criterion: super::Criterion,
     progress: &dyn Fn(u64, u64),
 ) -> (Vec<Link>, RefineStats) {
     let mut stats = RefineStats::default();
@@ -147,7 +148,7 @@ pub fn refine(
             let bytes = h.len() * BYTES_PER_ELEMENT + (out.len() + pending.len() + 4 * splits.len()) * BYTES_PER_LINK;
             let full = bytes > limits.max_bytes;
             let outcomes: Vec<Outcome> = {
-                let services = Services { hierarchy: h, caster, visibility, data, threshold_scale, shafts };
+                let services = Services { hierarchy: h, caster, visibility, data, threshold_scale, shafts, criterion };
                 batch.par_iter().map(|c| evaluate(&services, oracle, c, full)).collect()
             };
             for (c, outcome) in batch.iter().zip(outcomes) {

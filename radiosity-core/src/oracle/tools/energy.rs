@@ -64,9 +64,11 @@ impl Tool for SourceVariation {
 /// Is the error of a partly visible link above the threshold? The receiver's leaves all get the
 /// link's mean visibility `V`, so one in full shadow or full light is off by up to
 /// `B_S · F_max · max(V, 1 − V)`. The receiver's mean irradiance is right whatever `V`'s
-/// distribution (`V` is the kernel-weighted mean); what the shadow's shape changes is the light
-/// the receiver reflects on, in proportion to its reflectance `ρ_R`, so the bound used is
-/// `2 V (1 − V) · ρ_R · B_S · F_max` (0 for a link fully visible or hidden, or a black receiver).
+/// distribution (`V` is the kernel-weighted mean); what the shadow's shape changes is the
+/// irradiance of the receiver's parts, and the light it reflects on in proportion to its
+/// reflectance `ρ_R`, so the bound used is `2 V (1 − V) · w · B_S · F_max`, `w` the weight the
+/// criterion gives the receiver ([`LinkCtx::receiver_weight`]: `ρ_R` for the radiosity, 1 for the
+/// irradiance), 0 for a link fully visible or hidden.
 /// Casts the link's rays (kept for the link) only when the transfer could exceed the threshold at
 /// all. (The irradiance at a calculation point gathers its own visibility and needs no shadow
 /// in the mesh.)
@@ -76,7 +78,7 @@ pub struct PartialVisibility(pub f64);
 impl Tool for PartialVisibility {
     type Answer = ErrorBound;
     fn ask(&self, ctx: &mut LinkCtx<'_>) -> ErrorBound {
-        let transfer = ctx.emitter_radiosity() * ctx.form_factor_max() * ctx.receiver_reflectance();
+        let transfer = ctx.emitter_radiosity() * ctx.form_factor_max() * ctx.receiver_weight();
         let threshold = ctx.threshold(self.0);
         if 0.5 * transfer <= threshold {
             return ErrorBound::Below;
