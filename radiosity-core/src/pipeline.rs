@@ -700,7 +700,12 @@ fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, c
     }
     let mesh =
         solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
-    let noise = solve::visibility_noise(h, links, &sol.radiosity, config.visibility.rays);
+    // Under the irradiance criterion new links keep a visibility of more segments.
+    let kept_rays = match config.criterion {
+        refine::Criterion::Radiosity => config.visibility.rays,
+        refine::Criterion::Irradiance => config.visibility.rays.saturating_mul(refine::KEPT_VISIBILITY_FACTOR),
+    };
+    let noise = solve::visibility_noise(h, links, &sol.radiosity, kept_rays);
     solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
 }
 
