@@ -689,23 +689,33 @@ fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solu
 /// ([`solve::visibility_noise`]) where that is larger, times [`solve::ESTIMATE_SAFETY`].
 fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config, max_bytes: usize) -> f64 {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
-    let mut means = vec![crate::output::polygon_results(h, sol).into_iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
+    // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
+    let irradiance = config.criterion == refine::Criterion::Irradiance;
+    let results = crate::output::polygon_results(h, sol);
+    let mut means = vec![results.iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
+    let mut h_means = vec![results.iter().map(|r| r.h).collect::<Vec<[f64; 3]>>()];
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
         let coefficients =
             solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error));
         let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
-        means.push(crate::output::polygon_results(h, &coarse).into_iter().map(|r| r.b).collect());
+        let results = crate::output::polygon_results(h, &coarse);
+        means.push(results.iter().map(|r| r.b).collect());
+        h_means.push(results.iter().map(|r| r.h).collect());
     }
-    let mesh =
+    let mut mesh =
         solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
     // Under the irradiance criterion new links keep a visibility of more segments.
     let kept_rays = match config.criterion {
         refine::Criterion::Radiosity => config.visibility.rays,
         refine::Criterion::Irradiance => config.visibility.rays.saturating_mul(refine::KEPT_VISIBILITY_FACTOR),
     };
-    let noise = solve::visibility_noise(h, links, &sol.radiosity, kept_rays);
+    let mut noise = solve::visibility_noise(h, links, &sol.radiosity, kept_rays);
+    if irradiance {
+        mesh = mesh.max(solve::richardson_estimate(&emitting, &h_means[0], &h_means[1], &h_means[2]));
+        noise = noise.max(solve::visibility_noise_irradiance(h, links, &sol.radiosity, &h_means[0], kept_rays));
+    }
     solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
 }
 

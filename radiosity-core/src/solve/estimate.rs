@@ -127,6 +127,28 @@ pub const NOISE_SIGMAS: f64 = 1.0;
 /// radiosity. [`NOISE_SIGMAS`] standard deviations, largest over the non-emitting polygons.
 #[must_use]
 pub fn visibility_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]], rays: u32) -> f64 {
+    let sd = irradiance_noise(h, links, radiosity, rays);
+    NOISE_SIGMAS * worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * sd[p][c])
+}
+
+/// The same noise in each polygon's mean irradiance (no reflectance turns it into radiosity),
+/// relative to the largest non-emitting mean irradiance (`irradiance`, the polygons' means), for
+/// the irradiance criterion: a black receiver's is counted too.
+#[must_use]
+pub fn visibility_noise_irradiance(
+    h: &crate::hierarchy::Hierarchy,
+    links: &[crate::refine::Link],
+    radiosity: &[[f64; 3]],
+    irradiance: &[[f64; 3]],
+    rays: u32,
+) -> f64 {
+    let sd = irradiance_noise(h, links, radiosity, rays);
+    NOISE_SIGMAS * worst_relative(h, irradiance, |p, c| sd[p][c])
+}
+
+/// One standard deviation of each polygon's mean irradiance from visibility sampling (see
+/// [`visibility_noise`]).
+fn irradiance_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]], rays: u32) -> Vec<[f64; 3]> {
     let n = h.n_polygons as usize;
     let mut var = vec![[0.0; 3]; n];
     let rays = f64::from(rays.max(1));
@@ -142,7 +164,7 @@ pub fn visibility_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine:
             }
         });
     }
-    NOISE_SIGMAS * worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * var[p][c].sqrt())
+    var.into_iter().map(|v| v.map(f64::sqrt)).collect()
 }
 
 /// Calls `add(polygon, share)` for every polygon a link's `receiver` covers: a surface's own with
