@@ -224,7 +224,7 @@ impl<'a> LinkCtx<'a> {
     /// An oracle keeps a link because its segments agreed (all clear, all blocked, or a fraction
     /// whose error looked small); kept with those same segments, the links along a penumbra were
     /// biased by that choice: black sensors of CIE 171 case 5.7 read 2.6–4.7% low at 16 rays (seeds
-    /// 1–3), 1.6–3.6% with a fresh sample of as many, 0.4–0.6% with one of 4 times as many
+    /// 1–3), 1.6–3.6% with a fresh sample of as many, 0.2–0.8% with one of 4 times as many
     /// ([`super::KEPT_VISIBILITY_FACTOR`]).
     pub fn fresh_visibility(&mut self, rays: u32) -> f64 {
         let Some((_, n)) = self.data.visibility else { return self.visibility(rays) };
