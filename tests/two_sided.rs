@@ -130,24 +130,11 @@ fn back_to_back_faces_of_different_materials_stay_apart_with_a_counted_warning()
     assert!(messages.iter().any(|m| m.as_str().unwrap().contains("leaf.obj: polygon 1") && m.as_str().unwrap().contains("`other`")), "{w}");
 }
 
-/// A small deterministic generator (SplitMix64) for the test's own leaves.
-struct Mix(u64);
-
-impl Mix {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// `n` square leaves of side `side`, normals uniform over the sphere, centres uniform over
 /// `[-half, half]²` in x, y and `[0.5, 2.5]` in z, their vertices rounded to nine decimals (as
 /// other tools write them: each quad is planar only to that rounding).
 fn canopy_leaves(n: usize, side: f64, half: f64, seed: u64) -> Vec<[[f64; 3]; 4]> {
-    let mut rng = Mix(seed);
+    let mut rng = photons::Rng(seed);
     (0..n)
         .map(|_| {
             let c = [half * (2.0 * rng.next() - 1.0), half * (2.0 * rng.next() - 1.0), 0.5 + 2.0 * rng.next()];
@@ -209,7 +196,7 @@ const BALANCE_TOL: f64 = 1e-4;
 /// up to three times the front's irradiance, and a 400-leaf canopy balanced at 1.014.
 #[test]
 fn a_leaf_planar_only_to_its_decimals_does_not_light_its_own_back() {
-    let mut rng = Mix(7);
+    let mut rng = photons::Rng(7);
     for k in 0..12 {
         let dir = tempfile::tempdir().unwrap();
         let obj = canopy_obj(1, 0.1 + 0.3 * rng.next(), 0.0, 1000 + k, false);

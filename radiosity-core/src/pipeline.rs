@@ -402,6 +402,10 @@ pub struct Solved {
     /// [`solve::LevelHistory`]); `None` when [`Config::estimate_error`] is off or one level was
     /// solved.
     pub error_estimate: Option<f64>,
+    /// The quantities [`Solved::error_estimate`] covers, each relative to its own largest
+    /// non-emitting polygon mean: `radiosity`, and `irradiance` under the irradiance criterion;
+    /// empty without an estimate.
+    pub error_estimate_covers: Vec<&'static str>,
     /// Whether refinement stopped short for the memory budget ([`Config::max_memory_bytes`]).
     pub memory_limited: bool,
     /// The fraction of the light leaving the surfaces that escapes the scene, sampled
@@ -666,6 +670,11 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         shaft_classified,
         traits,
         left_out,
+        error_estimate_covers: match (error_estimate, config.criterion) {
+            (None, _) => Vec::new(),
+            (Some(_), refine::Criterion::Radiosity) => vec!["radiosity"],
+            (Some(_), refine::Criterion::Irradiance) => vec!["radiosity", "irradiance"],
+        },
         error_estimate,
         iterations,
         timings,
@@ -706,16 +715,11 @@ fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, c
     }
     let mut mesh =
         solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
-    // Under the irradiance criterion new links keep a visibility of more segments.
-    let kept_rays = match config.criterion {
-        refine::Criterion::Radiosity => config.visibility.rays,
-        refine::Criterion::Irradiance => config.visibility.rays.saturating_mul(refine::KEPT_VISIBILITY_FACTOR),
-    };
-    let mut noise = solve::visibility_noise(h, links, &sol.radiosity, kept_rays);
     if irradiance {
         mesh = mesh.max(solve::richardson_estimate(&emitting, &h_means[0], &h_means[1], &h_means[2]));
-        noise = noise.max(solve::visibility_noise_irradiance(h, links, &sol.radiosity, &h_means[0], kept_rays));
     }
+    let kept_rays = config.criterion.kept_rays(config.visibility.rays);
+    let noise = solve::visibility_noise(h, links, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()), kept_rays);
     solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
 }
 

@@ -318,9 +318,6 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     });
     let mut stats = Stats::from_solved(&scene, &solved, &args.oracle, params, (load, 0.0, 0.0));
     stats.target_error = config.target_error;
-    if stats.error_estimate.is_some() && config.criterion == radiosity::refine::Criterion::Irradiance {
-        stats.error_estimate_covers.push("irradiance");
-    }
     if let Some(b) = &bands {
         stats.sun.clone_from(&b.sun_report);
     }

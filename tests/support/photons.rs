@@ -77,11 +77,13 @@ fn unit(a: V) -> V {
     scale(a, 1.0 / dot(a, a).sqrt())
 }
 
-/// SplitMix64: a small seeded generator of uniform numbers in [0, 1).
-struct Rng(u64);
+/// SplitMix64: a small seeded generator of uniform numbers in [0, 1) (the tests' own scenes draw
+/// from it too).
+pub struct Rng(pub u64);
 
 impl Rng {
-    fn next(&mut self) -> f64 {
+    /// The next number.
+    pub fn next(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);

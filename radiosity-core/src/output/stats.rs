@@ -67,8 +67,7 @@ pub struct Stats {
     /// relative to the largest non-emitting polygon mean (see
     /// [`crate::pipeline::Solved::error_estimate`]; null when not estimated).
     pub error_estimate: Option<f64>,
-    /// The quantities the estimate covers, each relative to its own largest non-emitting polygon
-    /// mean: `radiosity`, and `irradiance` under the irradiance criterion.
+    /// The quantities the estimate covers ([`crate::pipeline::Solved::error_estimate_covers`]).
     pub error_estimate_covers: Vec<&'static str>,
     /// The target error the solve refined to (null when it refined to a fixed eps).
     pub target_error: Option<f64>,
@@ -344,7 +343,7 @@ impl Stats {
             passes: solved.passes,
             residual: solved.solution.residual,
             error_estimate: solved.error_estimate,
-            error_estimate_covers: if solved.error_estimate.is_some() { vec!["radiosity"] } else { Vec::new() },
+            error_estimate_covers: solved.error_estimate_covers.clone(),
             target_error: None,
             levels: solved.levels.clone(),
             time_s: StatsTimes {

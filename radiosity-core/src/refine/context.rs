@@ -34,7 +34,26 @@ impl Criterion {
     pub fn from_name(name: &str) -> Option<Criterion> {
         Criterion::ALL.into_iter().find(|c| c.name() == name)
     }
+
+    /// How many segments the visibility a new link keeps is sampled with, for `--rays` `rays`:
+    /// `rays`, or [`KEPT_VISIBILITY_FACTOR`] times as many under the irradiance criterion
+    /// ([`LinkCtx::fresh_visibility`]). The error estimate's visibility noise counts these.
+    #[must_use]
+    pub fn kept_rays(self, rays: u32) -> u32 {
+        match self {
+            Criterion::Radiosity => rays,
+            Criterion::Irradiance => rays.saturating_mul(KEPT_VISIBILITY_FACTOR),
+        }
+    }
 }
+
+/// Under [`Criterion::Irradiance`], how many times `--rays` segments the visibility kept for a new
+/// link is sampled with ([`LinkCtx::fresh_visibility`]). CIE 171 case 5.7's black sensors at
+/// `--eps 0.01`, seeds 1–3, worst error: a fresh sample of `--rays` segments 1.6–3.6%, of 4 times
+/// as many 0.41–0.55% (17–23k links, 0.2 s); more rays for the oracle's own decision (up to 16
+/// times, where the estimate's error was over half the threshold) doubled the links and changed
+/// nothing.
+pub const KEPT_VISIBILITY_FACTOR: u32 = 4;
 
 /// Read-only services shared by every link of a refinement pass.
 pub struct Services<'a> {
@@ -129,9 +148,6 @@ pub struct LinkCtx<'a> {
     pub parent_candidates: Option<std::sync::Arc<[u32]>>,
     /// Memoised shaft classification and candidate list.
     pub shaft: Option<(crate::visibility::shaft::ShaftClass, std::sync::Arc<[u32]>)>,
-    /// Mixed into the visibility seed: 0, or [`FRESH_VISIBILITY_SALT`] for the sample
-    /// [`LinkCtx::fresh_visibility`] draws.
-    seed_salt: u64,
 }
 
 /// What [`LinkCtx::fresh_visibility`] mixes into the seed, so that its segments are independent of
@@ -142,7 +158,7 @@ impl<'a> LinkCtx<'a> {
     /// A fresh context.
     #[must_use]
     pub fn new(services: &'a Services<'a>, emitter: u32, receiver: u32) -> LinkCtx<'a> {
-        LinkCtx { services, emitter, receiver, data: LinkData::default(), parent_candidates: None, shaft: None, seed_salt: 0 }
+        LinkCtx { services, emitter, receiver, data: LinkData::default(), parent_candidates: None, shaft: None }
     }
 
     /// The shaft classification of this link (memoised), when shaft culling is enabled: candidates
@@ -214,25 +230,20 @@ impl<'a> LinkCtx<'a> {
         f
     }
 
-    /// The sampling of `rays` segments for this link.
-    fn visibility_config(&self, rays: u32) -> VisibilityConfig {
-        VisibilityConfig { rays, seed: self.services.visibility.seed ^ self.seed_salt }
-    }
-
     /// The visibility fraction to keep for the link: a sample of at least `rays` segments (as many
     /// as the oracle cast) drawn independently of the one the oracle decided on, when it cast any.
     /// An oracle keeps a link because its segments agreed (all clear, all blocked, or a fraction
     /// whose error looked small); kept with those same segments, the links along a penumbra were
     /// biased by that choice: black sensors of CIE 171 case 5.7 read 2.6–4.7% low at 16 rays (seeds
     /// 1–3), 1.6–3.6% with a fresh sample of as many, 0.2–0.8% with one of 4 times as many
-    /// ([`super::KEPT_VISIBILITY_FACTOR`]).
+    /// ([`KEPT_VISIBILITY_FACTOR`]).
     pub fn fresh_visibility(&mut self, rays: u32) -> f64 {
-        let Some((_, n)) = self.data.visibility else { return self.visibility(rays) };
-        self.data.visibility = None;
-        self.seed_salt = FRESH_VISIBILITY_SALT;
-        let v = self.visibility(n.max(rays));
-        self.seed_salt = 0;
-        v
+        match self.data.visibility {
+            None => self.visibility(rays),
+            Some((_, n)) => {
+                self.sample_visibility(VisibilityConfig { rays: n.max(rays), seed: self.services.visibility.seed ^ FRESH_VISIBILITY_SALT })
+            }
+        }
     }
 
     /// Visibility fraction with at least `rays` rays (1 when the scene needs no visibility).
@@ -242,6 +253,13 @@ impl<'a> LinkCtx<'a> {
         {
             return v;
         }
+        self.sample_visibility(VisibilityConfig { rays, ..self.services.visibility })
+    }
+
+    /// Visibility fraction from the segments `config` draws (1 when the scene needs no
+    /// visibility), memoised for the link.
+    fn sample_visibility(&mut self, config: VisibilityConfig) -> f64 {
+        let rays = config.rays;
         let v = match (self.services.caster, self.services.shafts) {
             (None, _) => 1.0,
             (Some(caster), Some(shafts)) => {
@@ -259,7 +277,6 @@ impl<'a> LinkCtx<'a> {
                     None if parent_len > shaft::MAX_CULL_PARENT_OBJECTS => {
                         // A long (or no) inherited list seldom shrinks to nothing: culling would
                         // cost about what the rays cost.
-                        let config = self.visibility_config(rays);
                         let v = caster.visibility(h, self.emitter, self.receiver, &config);
                         self.data.visibility = Some((v, rays));
                         return v;
@@ -280,7 +297,6 @@ impl<'a> LinkCtx<'a> {
                         1.0
                     }
                     ShaftClass::Partial { .. } => {
-                        let config = self.visibility_config(rays);
                         if shaft::n_polygons_among(shafts.objects, cands) > shaft::MAX_LOOP_POLYGONS {
                             // Long lists: the scene's BVH draws the same segments and is faster.
                             caster.visibility(h, self.emitter, self.receiver, &config)
@@ -292,10 +308,7 @@ impl<'a> LinkCtx<'a> {
                     }
                 }
             }
-            (Some(caster), None) => {
-                let config = self.visibility_config(rays);
-                caster.visibility(self.services.hierarchy, self.emitter, self.receiver, &config)
-            }
+            (Some(caster), None) => caster.visibility(self.services.hierarchy, self.emitter, self.receiver, &config),
         };
         self.data.visibility = Some((v, rays));
         v

@@ -183,14 +183,6 @@ pub fn refine(
     (out, stats)
 }
 
-/// Under [`super::Criterion::Irradiance`], how many times `--rays` segments the visibility kept
-/// for a new link is sampled with ([`super::LinkCtx::fresh_visibility`]). CIE 171 case 5.7's black
-/// sensors at `--eps 0.01`, seeds 1–3, worst error: a fresh sample of `--rays` segments 1.6–3.6%,
-/// of 4 times as many 0.41–0.55% (17–23k links, 0.2 s); more rays for the oracle's own decision
-/// (up to 16 times, where the estimate's error was over half the threshold) doubled the links and
-/// changed nothing.
-pub const KEPT_VISIBILITY_FACTOR: u32 = 4;
-
 fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate, memory_full: bool) -> Outcome {
     let h = services.hierarchy;
     if c.source == c.receiver {
@@ -206,10 +198,11 @@ fn evaluate(services: &Services<'_>, oracle: &dyn Oracle, c: &Candidate, memory_
         let ff = ctx.form_factor(FormFactorQuality::Precise);
         // Under the irradiance criterion the kept visibility is a sample the oracle did not decide
         // on, of more segments (see `LinkCtx::fresh_visibility`).
+        let kept = services.criterion.kept_rays(services.visibility.rays);
         let vis = match (ff > 0.0, services.criterion) {
             (false, _) => 0.0,
-            (true, super::Criterion::Irradiance) => ctx.fresh_visibility(services.visibility.rays.saturating_mul(KEPT_VISIBILITY_FACTOR)),
-            (true, super::Criterion::Radiosity) => ctx.visibility(services.visibility.rays),
+            (true, super::Criterion::Irradiance) => ctx.fresh_visibility(kept),
+            (true, super::Criterion::Radiosity) => ctx.visibility(kept),
         };
         Outcome::Keep(Link { source: c.source, receiver: c.receiver, ff, vis }, true, refused)
     };

@@ -125,25 +125,22 @@ pub const NOISE_SIGMAS: f64 = 1.0;
 /// `B_S F` times that; independent links add in quadrature over a polygon (each weighted by the
 /// share of the polygon's area its receiver covers), and the reflectance turns irradiance into
 /// radiosity. [`NOISE_SIGMAS`] standard deviations, largest over the non-emitting polygons.
+/// With `irradiance` (the polygons' mean irradiance, under the irradiance criterion) the same
+/// noise in each mean irradiance counts too (no reflectance turns it into radiosity: a black
+/// receiver's is counted), relative to the largest non-emitting mean irradiance; the larger of
+/// the two is returned.
 #[must_use]
-pub fn visibility_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]], rays: u32) -> f64 {
-    let sd = irradiance_noise(h, links, radiosity, rays);
-    NOISE_SIGMAS * worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * sd[p][c])
-}
-
-/// The same noise in each polygon's mean irradiance (no reflectance turns it into radiosity),
-/// relative to the largest non-emitting mean irradiance (`irradiance`, the polygons' means), for
-/// the irradiance criterion: a black receiver's is counted too.
-#[must_use]
-pub fn visibility_noise_irradiance(
+pub fn visibility_noise(
     h: &crate::hierarchy::Hierarchy,
     links: &[crate::refine::Link],
     radiosity: &[[f64; 3]],
-    irradiance: &[[f64; 3]],
+    irradiance: Option<&[[f64; 3]]>,
     rays: u32,
 ) -> f64 {
     let sd = irradiance_noise(h, links, radiosity, rays);
-    NOISE_SIGMAS * worst_relative(h, irradiance, |p, c| sd[p][c])
+    let of_radiosity = worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * sd[p][c]);
+    let of_irradiance = irradiance.map_or(0.0, |means| worst_relative(h, means, |p, c| sd[p][c]));
+    NOISE_SIGMAS * of_radiosity.max(of_irradiance)
 }
 
 /// One standard deviation of each polygon's mean irradiance from visibility sampling (see
