@@ -511,6 +511,17 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             for e in h.match_sides() {
                 data.inherit(&h, e);
             }
+            let mut s = s;
+            if config.criterion == refine::Criterion::Irradiance && use_visibility {
+                let fresh = VisibilityConfig {
+                    rays: config.criterion.kept_rays(config.visibility.rays),
+                    seed: config.visibility.seed ^ refine::FRESH_VISIBILITY_SALT,
+                };
+                let (pushed, form_factors) = refine::push_direct_shadows(&h, &caster, fresh, links);
+                links = pushed;
+                s.form_factors += form_factors;
+                s.links = links.len() as u64;
+            }
             crate::luminaire::update_direct(&mut h, config.use_visibility.then_some(&caster));
             timings.refine += t.elapsed().as_secs_f64();
             stats.oracle_calls += s.oracle_calls;

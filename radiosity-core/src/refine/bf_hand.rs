@@ -72,7 +72,7 @@ pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
     }
     let transfer = b * ctx.form_factor_max() * ctx.receiver_weight();
     if 0.5 * transfer > threshold {
-        let v = ctx.visibility(ctx.services.visibility.rays);
+        let v = ctx.decision_visibility(transfer, threshold);
         if 2.0 * v * (1.0 - v) * transfer > threshold {
             return split(ctx);
         }

@@ -272,3 +272,50 @@ fn split(h: &mut Hierarchy, data: &mut super::ElementData, pending: PendingSplit
         Decision::Link | Decision::Stop => unreachable!("split is only called for subdivisions"),
     }
 }
+
+/// Links from an emitting surface that its receiver sees in part, pushed down to the receiver's
+/// leaves: each leaf gets its own link from the same source, with its own precise form factor and
+/// its own visibility ([`super::Criterion::kept_rays`] segments, drawn as a kept link's are);
+/// every other link is kept as it is. `(links, form factors computed)`.
+///
+/// A link stored at a coarse receiver hands its mean visibility to every leaf below it. Each such
+/// link is held to the oracle's threshold, but the links from the pieces of one lamp see the same
+/// occluder: their errors on a leaf beside a shadow add up instead of averaging out. On a block
+/// standing under a lamp split into 60 pieces, a 3 cm floor element in the block's penumbra read
+/// 26% of the band's largest irradiance below its exact mean, every one of its links within the
+/// threshold. Direct light carries the sharpest shadows (the light of reflecting surfaces is
+/// spread over many sources and soft), so only emitters' links are pushed: the number of
+/// links grows by the leaves under partly visible direct links, and nothing is subdivided.
+#[must_use]
+pub fn push_direct_shadows(h: &Hierarchy, caster: &RayCaster, visibility: VisibilityConfig, links: Vec<Link>) -> (Vec<Link>, u64) {
+    let emits = |e: ElementId| h.get(e).polygon().is_some_and(|p| h.emission[p as usize].iter().any(|&x| x > 0.0));
+    let pushed =
+        |l: &Link| l.vis > 0.0 && l.vis < 1.0 && h.get(l.receiver).n_children > 0 && h.get(l.receiver).poly().is_some() && emits(l.source);
+    if !links.iter().any(pushed) {
+        return (links, 0);
+    }
+    let parts: Vec<Vec<Link>> = links
+        .par_iter()
+        .map(|l| {
+            if !pushed(l) {
+                return vec![*l];
+            }
+            let mut out = Vec::new();
+            let mut stack = vec![l.receiver];
+            while let Some(e) = stack.pop() {
+                let children = h.children_of(e);
+                if !children.is_empty() {
+                    stack.extend_from_slice(children);
+                    continue;
+                }
+                let ff = crate::formfactor::link_form_factor(h, l.source, e, FormFactorQuality::Precise);
+                if ff > MIN_LINK_FORM_FACTOR {
+                    out.push(Link { source: l.source, receiver: e, ff, vis: caster.visibility(h, l.source, e, &visibility) });
+                }
+            }
+            out
+        })
+        .collect();
+    let form_factors = parts.iter().zip(&links).filter(|(_, l)| pushed(l)).map(|(p, _)| p.len() as u64).sum();
+    (parts.into_iter().flatten().collect(), form_factors)
+}

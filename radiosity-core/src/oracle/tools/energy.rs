@@ -83,7 +83,7 @@ impl Tool for PartialVisibility {
         if 0.5 * transfer <= threshold {
             return ErrorBound::Below;
         }
-        let v = ctx.visibility(ctx.services.visibility.rays);
+        let v = ctx.decision_visibility(transfer, threshold);
         if 2.0 * v * (1.0 - v) * transfer > threshold { ErrorBound::Above } else { ErrorBound::Below }
     }
 }
