@@ -10,6 +10,9 @@ use radiosity::hierarchy::Hierarchy;
 use radiosity::pipeline::{self, Config};
 use radiosity::refine::{BfHand, Criterion};
 
+#[path = "support/obj.rs"]
+mod obj;
+
 /// The block: x, z ∈ [−A, A], y ∈ [0, HEIGHT] (metres).
 const A: f64 = 0.2;
 const HEIGHT: f64 = 0.4;
@@ -25,30 +28,17 @@ const BAND: f64 = 0.06;
 const ELEMENT_TOL: f64 = 0.03;
 
 fn scene_obj() -> String {
-    let mut obj = String::from("mtllib blk.mtl\n");
-    let mut n = 0;
-    let mut quad = |v: [[f64; 3]; 4], normal: [f64; 3], material: &str| {
-        let e1: [f64; 3] = std::array::from_fn(|k| v[1][k] - v[0][k]);
-        let e2: [f64; 3] = std::array::from_fn(|k| v[2][k] - v[0][k]);
-        let cross = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
-        let facing = cross.iter().zip(normal).map(|(a, b)| a * b).sum::<f64>() > 0.0;
-        let order: [usize; 4] = if facing { [0, 1, 2, 3] } else { [3, 2, 1, 0] };
-        for &i in &order {
-            obj.push_str(&format!("v {} {} {}\n", v[i][0], v[i][1], v[i][2]));
-        }
-        obj.push_str(&format!("o {material}{n}\nusemtl {material}\nf {} {} {} {}\n", n + 1, n + 2, n + 3, n + 4));
-        n += 4;
-    };
-    quad([[-1., 0., -1.], [1., 0., -1.], [1., 0., 1.], [-1., 0., 1.]], [0., 1., 0.], "floor");
+    let mut obj = obj::Obj::new("blk.mtl");
+    obj.quad([[-1., 0., -1.], [1., 0., -1.], [1., 0., 1.], [-1., 0., 1.]], [0., 1., 0.], "floor");
     let (a, h) = (A, HEIGHT);
-    quad([[-a, h, -a], [a, h, -a], [a, h, a], [-a, h, a]], [0., 1., 0.], "black");
-    quad([[-a, 0., -a], [a, 0., -a], [a, h, -a], [-a, h, -a]], [0., 0., -1.], "black");
-    quad([[-a, 0., a], [a, 0., a], [a, h, a], [-a, h, a]], [0., 0., 1.], "black");
-    quad([[-a, 0., -a], [-a, 0., a], [-a, h, a], [-a, h, -a]], [-1., 0., 0.], "black");
-    quad([[a, 0., -a], [a, 0., a], [a, h, a], [a, h, -a]], [1., 0., 0.], "black");
+    obj.quad([[-a, h, -a], [a, h, -a], [a, h, a], [-a, h, a]], [0., 1., 0.], "black");
+    obj.quad([[-a, 0., -a], [a, 0., -a], [a, h, -a], [-a, h, -a]], [0., 0., -1.], "black");
+    obj.quad([[-a, 0., a], [a, 0., a], [a, h, a], [-a, h, a]], [0., 0., 1.], "black");
+    obj.quad([[-a, 0., -a], [-a, 0., a], [-a, h, a], [-a, h, -a]], [-1., 0., 0.], "black");
+    obj.quad([[a, 0., -a], [a, 0., a], [a, h, a], [a, h, -a]], [1., 0., 0.], "black");
     let ([x0, x1], [z0, z1], y) = LAMP;
-    quad([[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], [0., -1., 0.], "lamp");
-    obj
+    obj.quad([[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], [0., -1., 0.], "lamp");
+    obj.text
 }
 
 const MTL: &str = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl black\nKd 0 0 0\nnewmtl lamp\nKd 0 0 0\nKe 100 100 100\n";

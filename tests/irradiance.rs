@@ -6,6 +6,9 @@
 use std::path::Path;
 use std::process::Command;
 
+#[path = "support/obj.rs"]
+mod obj;
+
 /// CIE 171:2006 case 5.7, as corrected (NVIDIA Iray validation report, Table 14; the printed
 /// Table 19 is wrong): `E/(E_v·ρ)` in % at points A–F on the black wall y = 0 (x = 2, z = 2.75 …
 /// 0.25) and G–K on the black floor (x = 2, y = 0.25 … 2.25). With the lit wall emitting
@@ -34,52 +37,25 @@ const SENSOR_TOL: f64 = 0.02;
 /// averaged over it).
 const SHADOWED_MAX: f64 = 0.005 * 16.071;
 
-/// A quad with the given front normal (its vertices reordered to face it), as OBJ lines.
-fn quad(obj: &mut String, n_vertices: &mut usize, v: [[f64; 3]; 4], normal: [f64; 3], material: &str) {
-    let (e1, e2) = (std::array::from_fn::<f64, 3, _>(|k| v[1][k] - v[0][k]), std::array::from_fn::<f64, 3, _>(|k| v[2][k] - v[0][k]));
-    let cross = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
-    let facing = cross.iter().zip(normal).map(|(a, b)| a * b).sum::<f64>() > 0.0;
-    let order: [usize; 4] = if facing { [0, 1, 2, 3] } else { [3, 2, 1, 0] };
-    for &i in &order {
-        obj.push_str(&format!("v {} {} {}\n", v[i][0], v[i][1], v[i][2]));
-    }
-    let b = *n_vertices + 1;
-    *n_vertices += 4;
-    obj.push_str(&format!("o {material}{b}\nusemtl {material}\nf {} {} {} {}\n", b, b + 1, b + 2, b + 3));
-}
-
 /// The case's scene: the lit wall S2 (4 × 3 m at y = 4, facing −y) emitting 100 W/m², the black
 /// wall at y = 0, the black floor strip y ∈ [0, 2.5], the black box x ∈ [0, 4], y ∈ [2.5, 2.7],
 /// z ∈ [0, 1], and a 2 cm black sensor 1 mm in front of each point.
 fn scene(dir: &Path) {
-    let mut obj = String::from("mtllib cie57.mtl\n");
-    let mut n = 0;
-    quad(&mut obj, &mut n, [[0., 4., 0.], [4., 4., 0.], [4., 4., 3.], [0., 4., 3.]], [0., -1., 0.], "s2");
-    quad(&mut obj, &mut n, [[0., 0., 0.], [4., 0., 0.], [4., 0., 3.], [0., 0., 3.]], [0., 1., 0.], "black");
-    quad(&mut obj, &mut n, [[0., 0., 0.], [4., 0., 0.], [4., 2.5, 0.], [0., 2.5, 0.]], [0., 0., 1.], "black");
-    quad(&mut obj, &mut n, [[0., 2.5, 1.], [4., 2.5, 1.], [4., 2.7, 1.], [0., 2.7, 1.]], [0., 0., 1.], "black");
-    quad(&mut obj, &mut n, [[0., 2.5, 0.], [4., 2.5, 0.], [4., 2.5, 1.], [0., 2.5, 1.]], [0., -1., 0.], "black");
-    quad(&mut obj, &mut n, [[0., 2.7, 0.], [4., 2.7, 0.], [4., 2.7, 1.], [0., 2.7, 1.]], [0., 1., 0.], "black");
+    let mut obj = obj::Obj::new("cie57.mtl");
+    obj.quad([[0., 4., 0.], [4., 4., 0.], [4., 4., 3.], [0., 4., 3.]], [0., -1., 0.], "s2");
+    obj.quad([[0., 0., 0.], [4., 0., 0.], [4., 0., 3.], [0., 0., 3.]], [0., 1., 0.], "black");
+    obj.quad([[0., 0., 0.], [4., 0., 0.], [4., 2.5, 0.], [0., 2.5, 0.]], [0., 0., 1.], "black");
+    obj.quad([[0., 2.5, 1.], [4., 2.5, 1.], [4., 2.7, 1.], [0., 2.7, 1.]], [0., 0., 1.], "black");
+    obj.quad([[0., 2.5, 0.], [4., 2.5, 0.], [4., 2.5, 1.], [0., 2.5, 1.]], [0., -1., 0.], "black");
+    obj.quad([[0., 2.7, 0.], [4., 2.7, 0.], [4., 2.7, 1.], [0., 2.7, 1.]], [0., 1., 0.], "black");
     let h = 0.01;
     for z in [2.75, 2.25, 1.75, 1.25, 0.75, 0.25] {
-        quad(
-            &mut obj,
-            &mut n,
-            [[2. - h, 0.001, z - h], [2. + h, 0.001, z - h], [2. + h, 0.001, z + h], [2. - h, 0.001, z + h]],
-            [0., 1., 0.],
-            "sensor",
-        );
+        obj.quad([[2. - h, 0.001, z - h], [2. + h, 0.001, z - h], [2. + h, 0.001, z + h], [2. - h, 0.001, z + h]], [0., 1., 0.], "sensor");
     }
     for y in [0.25, 0.75, 1.25, 1.75, 2.25] {
-        quad(
-            &mut obj,
-            &mut n,
-            [[2. - h, y - h, 0.001], [2. + h, y - h, 0.001], [2. + h, y + h, 0.001], [2. - h, y + h, 0.001]],
-            [0., 0., 1.],
-            "sensor",
-        );
+        obj.quad([[2. - h, y - h, 0.001], [2. + h, y - h, 0.001], [2. + h, y + h, 0.001], [2. - h, y + h, 0.001]], [0., 0., 1.], "sensor");
     }
-    std::fs::write(dir.join("cie57.obj"), obj).unwrap();
+    std::fs::write(dir.join("cie57.obj"), obj.text).unwrap();
     std::fs::write(dir.join("cie57.mtl"), "newmtl s2\nKd 0 0 0\nKe 100 100 100\nnewmtl black\nKd 0 0 0\nnewmtl sensor\nKd 0 0 0\n")
         .unwrap();
 }
