@@ -32,6 +32,12 @@ const CIE_57: [(&str, f64); 11] = [
 /// The bar for a sensor's irradiance against the exact point value.
 const SENSOR_TOL: f64 = 0.02;
 
+/// Case 5.3's bar for a sensor against its own exact irradiance, relative to the largest
+/// non-emitting mean irradiance: a tenth of the default target error, since an unobstructed
+/// source's direct light needs exact form factors and no refinement (measured: 1.1e-4, see
+/// `black_sensors_meet_cie_171_case_5_3_at_the_default_settings`).
+const SENSOR_SOLVER_TOL: f64 = 1e-3;
+
 /// Largest irradiance of a sensor in full shadow: half a percent of the brightest sensor's (J's
 /// 2 cm square reaches 1 cm past the shadow line, where it sees a sliver of the wall: 0.024 W/m²
 /// averaged over it).
@@ -69,8 +75,13 @@ struct Run {
 }
 
 fn solve(dir: &Path, args: &[&str]) -> Run {
+    solve_file(dir, "cie57.obj", args)
+}
+
+/// [`solve`] of scene file `file` (its emitter's material `s2` or `source`).
+fn solve_file(dir: &Path, file: &str, args: &[&str]) -> Run {
     let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
-        .args(["solve", "cie57.obj", "--quiet", "--no-image", "--out", "out"])
+        .args(["solve", file, "--quiet", "--no-image", "--out", "out"])
         .args(args)
         .current_dir(dir)
         .output()
@@ -82,7 +93,7 @@ fn solve(dir: &Path, args: &[&str]) -> Run {
     let (m, h) = (header.iter().position(|&c| c == "material").unwrap(), header.iter().position(|&c| c == "h_r").unwrap());
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     let sensors = rows.iter().filter(|r| r[m] == "sensor").map(|r| r[h].parse().unwrap()).collect();
-    let top = rows.iter().filter(|r| r[m] != "s2").map(|r| r[h].parse::<f64>().unwrap()).fold(0.0, f64::max);
+    let top = rows.iter().filter(|r| r[m] != "s2" && r[m] != "source").map(|r| r[h].parse::<f64>().unwrap()).fold(0.0, f64::max);
     let stats = serde_json::from_str(&std::fs::read_to_string(dir.join("out/stats.json")).unwrap()).unwrap();
     Run { sensors, top, stats }
 }
@@ -136,5 +147,124 @@ fn the_estimate_bounds_the_black_sensors_error_under_the_irradiance_criterion() 
         let estimate = run.stats["error_estimate"].as_f64().unwrap();
         let worst = CIE_57.iter().zip(&run.sensors).map(|(&(_, want), &h)| (h - want).abs()).fold(0.0, f64::max) / run.top;
         assert!(estimate >= worst, "seed {seed}: estimate {estimate} below the true worst error {worst}");
+    }
+}
+
+/// CIE 171:2006 case 5.3 (area source, direct only): a black 4 × 4 × 3 m room, a 1 × 1 m
+/// Lambertian source of luminance 1000 (exitance π·1000) centred in the ceiling facing down;
+/// `E = π L F(dA → source)` at points on the wall y = 0 (x = 2, z = 2.75 … 0.25) and on the floor
+/// (x = 2, y = 0.25 … 3.75). Values from `../shared/reference/cie171.md` (our exact form factors;
+/// the report's table differs by up to 0.26%).
+const CIE_53_WALL: [(&str, f64, f64); 6] =
+    [("A", 2.75, 32.677), ("B", 2.25, 75.194), ("C", 1.75, 81.323), ("D", 1.25, 69.061), ("E", 0.75, 53.404), ("F", 0.25, 40.002)];
+const CIE_53_FLOOR: [(&str, f64, f64); 8] = [
+    ("G", 0.25, 61.424),
+    ("H", 0.75, 79.255),
+    ("I", 1.25, 95.667),
+    ("J", 1.75, 105.778),
+    ("K", 2.25, 105.778),
+    ("L", 2.75, 95.667),
+    ("M", 3.25, 79.255),
+    ("N", 3.75, 61.424),
+];
+
+/// Case 5.3's room with a 2 cm black sensor 1 mm in front of each point (wall points first).
+fn scene_53(dir: &Path) {
+    let mut obj = obj::Obj::new("cie53.mtl");
+    let k = "black";
+    obj.quad([[0., 0., 0.], [4., 0., 0.], [4., 4., 0.], [0., 4., 0.]], [0., 0., 1.], k);
+    obj.quad([[0., 0., 0.], [4., 0., 0.], [4., 0., 3.], [0., 0., 3.]], [0., 1., 0.], k);
+    obj.quad([[0., 4., 0.], [4., 4., 0.], [4., 4., 3.], [0., 4., 3.]], [0., -1., 0.], k);
+    obj.quad([[0., 0., 0.], [0., 4., 0.], [0., 4., 3.], [0., 0., 3.]], [1., 0., 0.], k);
+    obj.quad([[4., 0., 0.], [4., 4., 0.], [4., 4., 3.], [4., 0., 3.]], [-1., 0., 0.], k);
+    // The ceiling around the source, then the source in its hole.
+    for (x, y) in [((0., 4.), (0., 1.5)), ((0., 4.), (2.5, 4.)), ((0., 1.5), (1.5, 2.5)), ((2.5, 4.), (1.5, 2.5))] {
+        obj.quad([[x.0, y.0, 3.], [x.1, y.0, 3.], [x.1, y.1, 3.], [x.0, y.1, 3.]], [0., 0., -1.], k);
+    }
+    obj.quad([[1.5, 1.5, 3.], [2.5, 1.5, 3.], [2.5, 2.5, 3.], [1.5, 2.5, 3.]], [0., 0., -1.], "source");
+    let h = 0.01;
+    for (_, z, _) in CIE_53_WALL {
+        obj.quad([[2. - h, 0.001, z - h], [2. + h, 0.001, z - h], [2. + h, 0.001, z + h], [2. - h, 0.001, z + h]], [0., 1., 0.], "sensor");
+    }
+    for (_, y, _) in CIE_53_FLOOR {
+        obj.quad([[2. - h, y - h, 0.001], [2. + h, y - h, 0.001], [2. + h, y + h, 0.001], [2. - h, y + h, 0.001]], [0., 0., 1.], "sensor");
+    }
+    std::fs::write(dir.join("cie53.obj"), obj.text).unwrap();
+    let exitance = std::f64::consts::PI * 1000.0;
+    std::fs::write(
+        dir.join("cie53.mtl"),
+        format!("newmtl source\nKd 0 0 0\nKe {exitance} {exitance} {exitance}\nnewmtl black\nKd 0 0 0\nnewmtl sensor\nKd 0 0 0\n"),
+    )
+    .unwrap();
+}
+
+/// The form factor from a point at `p` with normal `n` to a convex polygon (Lambert's contour
+/// formula: `1/2π Σ γ_i (u_i × u_{i+1})/|u_i × u_{i+1}| · n`, `u_i` the unit vectors to the
+/// vertices, `γ_i` the angle between consecutive ones), the polygon wholly in front of the point.
+fn point_form_factor(p: [f64; 3], n: [f64; 3], polygon: &[[f64; 3]]) -> f64 {
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let unit = |a: [f64; 3]| {
+        let l = dot(a, a).sqrt();
+        [a[0] / l, a[1] / l, a[2] / l]
+    };
+    let mut sum = 0.0;
+    for i in 0..polygon.len() {
+        let (u, v) = (unit(sub(polygon[i], p)), unit(sub(polygon[(i + 1) % polygon.len()], p)));
+        let c = cross(u, v);
+        sum += dot(u, v).clamp(-1.0, 1.0).acos() * dot(unit(c), n);
+    }
+    (sum / (2.0 * std::f64::consts::PI)).abs()
+}
+
+/// Every black sensor of case 5.3 within 2% of the report's point value at the default settings
+/// and under `--criterion irradiance`, and within [`SENSOR_SOLVER_TOL`] of its own exact
+/// irradiance (Lambert's formula over 3 × 3 points of it, 1 mm nearer the source than the report's
+/// point: J's exact value is 0.067% above the point's). Measured (both criteria): 806 links, every
+/// sensor 1.1e-4 below its exact value, the error estimate 1e-5 (its floor). The room is closed,
+/// and the closure that makes every source deliver its light whole scaled the source's links by
+/// 1/(1 + 1.1e-4) (form factors summing a little over 1 elsewhere): an error the estimate does not
+/// count yet.
+#[test]
+fn black_sensors_meet_cie_171_case_5_3_at_the_default_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    scene_53(dir.path());
+    let source = [[1.5, 1.5, 3.], [2.5, 1.5, 3.], [2.5, 2.5, 3.], [1.5, 2.5, 3.]];
+    let exitance = std::f64::consts::PI * 1000.0;
+    let h = 0.01;
+    let mean = |centre: [f64; 3], n: [f64; 3], along: [[f64; 3]; 2]| {
+        let mut e = 0.0;
+        for i in -1..=1 {
+            for j in -1..=1 {
+                let (a, b) = (f64::from(i) * h * 2.0 / 3.0, f64::from(j) * h * 2.0 / 3.0);
+                let p: [f64; 3] = std::array::from_fn(|k| centre[k] + a * along[0][k] + b * along[1][k]);
+                e += exitance * point_form_factor(p, n, &source);
+            }
+        }
+        e / 9.0
+    };
+    let sensors_exact: Vec<f64> = CIE_53_WALL
+        .iter()
+        .map(|&(_, z, _)| mean([2., 0.001, z], [0., 1., 0.], [[1., 0., 0.], [0., 0., 1.]]))
+        .chain(CIE_53_FLOOR.iter().map(|&(_, y, _)| mean([2., y, 0.001], [0., 0., 1.], [[1., 0., 0.], [0., 1., 0.]])))
+        .collect();
+    let report: Vec<(&str, f64)> = CIE_53_WALL.iter().chain(&CIE_53_FLOOR).map(|&(n, _, v)| (n, v)).collect();
+    for args in [&[][..], &["--criterion", "irradiance"][..]] {
+        let run = solve_file(dir.path(), "cie53.obj", args);
+        assert_eq!(run.sensors.len(), report.len());
+        let mut worst: f64 = 0.0;
+        for ((&(name, want), &h), &exact) in report.iter().zip(&run.sensors).zip(&sensors_exact) {
+            assert!((h - want).abs() <= SENSOR_TOL * want, "{args:?}, {name}: {h} W/m² against {want}");
+            worst = worst.max((h - exact).abs());
+        }
+        let estimate = run.stats["error_estimate"].as_f64().unwrap();
+        eprintln!(
+            "{args:?}: {} links, worst sensor {:.4}% of the largest mean, estimate {:.4}%",
+            run.stats["links"],
+            100.0 * worst / run.top,
+            100.0 * estimate
+        );
+        assert!(worst / run.top <= SENSOR_SOLVER_TOL, "{args:?}: a sensor is {worst} W/m² off its exact irradiance");
     }
 }
