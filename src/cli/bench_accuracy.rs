@@ -5,7 +5,7 @@
 
 use anyhow::Context;
 use radiosity::pipeline::{self, Config};
-use radiosity::refine::{BfHand, BfParams};
+use radiosity::refine::{BfHand, BfParams, Criterion};
 use radiosity::validation;
 use std::path::PathBuf;
 use std::process::Command;
@@ -26,9 +26,12 @@ pub struct AccuracyBenchArgs {
     /// Print one JSON document instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Internal: solve one case (`NAME EPS`, EPS `target` for the default target error) and print
-    /// its row as JSON.
-    #[arg(long, num_args = 2, hide = true)]
+    /// What the link criteria bound the error of (as `radiosity solve --criterion`).
+    #[arg(long, default_value = "radiosity", value_parser = ["radiosity", "irradiance"])]
+    pub criterion: String,
+    /// Internal: solve one case (`NAME EPS CRITERION`, EPS `target` for the default target error)
+    /// and print its row as JSON.
+    #[arg(long, num_args = 3, hide = true)]
     pub child: Vec<String>,
 }
 
@@ -40,8 +43,8 @@ pub const RENDERPARK_WARD: [(f64, f64, f64, f64); 5] =
 
 /// Runs `bench accuracy`.
 pub fn run(args: &AccuracyBenchArgs) -> anyhow::Result<()> {
-    if let [name, eps] = args.child.as_slice() {
-        return child(name, eps);
+    if let [name, eps, criterion] = args.child.as_slice() {
+        return child(name, eps, criterion);
     }
     anyhow::ensure!(args.eps.iter().all(|e| e.is_finite() && *e > 0.0 && *e <= 1.0), "--eps must be numbers in (0, 1]");
     let exe = std::env::current_exe().context("locating this executable")?;
@@ -57,7 +60,10 @@ pub fn run(args: &AccuracyBenchArgs) -> anyhow::Result<()> {
     for name in &names {
         let settings: Vec<String> = std::iter::once("target".to_string()).chain(args.eps.iter().map(|e| e.to_string())).collect();
         for eps in settings {
-            let out = Command::new(&exe).args(["bench", "accuracy", "--child", name, &eps]).output().context("running a child solve")?;
+            let out = Command::new(&exe)
+                .args(["bench", "accuracy", "--child", name, &eps, &args.criterion])
+                .output()
+                .context("running a child solve")?;
             anyhow::ensure!(out.status.success(), "{name} at {eps}: {}", String::from_utf8_lossy(&out.stderr).trim());
             let row: serde_json::Value = serde_json::from_slice(&out.stdout).context("reading a child's row")?;
             if !args.json {
@@ -152,13 +158,15 @@ fn write_files(out: &std::path::Path, rows: &[serde_json::Value]) -> anyhow::Res
 const WARD_CLASSES: [(&str, f64); 3] = [("floor", 0.033361), ("ceiling", 0.022187), ("wall", 0.027126)];
 
 /// Solves one case and prints its row.
-fn child(name: &str, eps: &str) -> anyhow::Result<()> {
+fn child(name: &str, eps: &str, criterion: &str) -> anyhow::Result<()> {
     let case = validation::cases().into_iter().find(|c| c.name == name).with_context(|| format!("no validation scene `{name}`"))?;
-    let (config, oracle_eps) = if eps == "target" {
+    let criterion = Criterion::from_name(criterion).with_context(|| format!("no criterion `{criterion}`"))?;
+    let (mut config, oracle_eps) = if eps == "target" {
         (Config { target_error: Some(super::DEFAULT_TARGET_ERROR), ..Config::default() }, BfParams::default().eps)
     } else {
         (Config::default(), eps.parse::<f64>().with_context(|| format!("bad eps `{eps}`"))?)
     };
+    config.criterion = criterion;
     let t0 = Instant::now();
     let solved = pipeline::run(&case.scene, &BfHand { params: BfParams { eps: oracle_eps } }, &config, &|_| {});
     let time = t0.elapsed().as_secs_f64();
@@ -185,6 +193,7 @@ fn child(name: &str, eps: &str) -> anyhow::Result<()> {
         "eps": if eps == "target" { serde_json::Value::Null } else { serde_json::json!(oracle_eps) },
         "eps_label": if eps == "target" { format!("target {}", super::DEFAULT_TARGET_ERROR) } else { eps.to_string() },
         "target_error": config.target_error,
+        "criterion": criterion.name(),
         "time_s": time,
         "peak_rss_bytes": radiosity::output::peak_rss_bytes(),
         "leaves": solved.hierarchy.leaves().count(),
