@@ -6,6 +6,8 @@
 use std::path::Path;
 use std::process::Command;
 
+#[path = "support/cie171.rs"]
+mod cie171;
 #[path = "support/obj.rs"]
 mod obj;
 
@@ -150,24 +152,6 @@ fn the_estimate_bounds_the_black_sensors_error_under_the_irradiance_criterion() 
     }
 }
 
-/// CIE 171:2006 case 5.3 (area source, direct only): a black 4 × 4 × 3 m room, a 1 × 1 m
-/// Lambertian source of luminance 1000 (exitance π·1000) centred in the ceiling facing down;
-/// `E = π L F(dA → source)` at points on the wall y = 0 (x = 2, z = 2.75 … 0.25) and on the floor
-/// (x = 2, y = 0.25 … 3.75). Values from `../shared/reference/cie171.md` (our exact form factors;
-/// the report's table differs by up to 0.26%).
-const CIE_53_WALL: [(&str, f64, f64); 6] =
-    [("A", 2.75, 32.677), ("B", 2.25, 75.194), ("C", 1.75, 81.323), ("D", 1.25, 69.061), ("E", 0.75, 53.404), ("F", 0.25, 40.002)];
-const CIE_53_FLOOR: [(&str, f64, f64); 8] = [
-    ("G", 0.25, 61.424),
-    ("H", 0.75, 79.255),
-    ("I", 1.25, 95.667),
-    ("J", 1.75, 105.778),
-    ("K", 2.25, 105.778),
-    ("L", 2.75, 95.667),
-    ("M", 3.25, 79.255),
-    ("N", 3.75, 61.424),
-];
-
 /// Case 5.3's room with a 2 cm black sensor 1 mm in front of each point (wall points first).
 fn scene_53(dir: &Path) {
     let mut obj = obj::Obj::new("cie53.mtl");
@@ -183,10 +167,10 @@ fn scene_53(dir: &Path) {
     }
     obj.quad([[1.5, 1.5, 3.], [2.5, 1.5, 3.], [2.5, 2.5, 3.], [1.5, 2.5, 3.]], [0., 0., -1.], "source");
     let h = 0.01;
-    for (_, z, _) in CIE_53_WALL {
+    for (_, z, _) in cie171::CASE_53_WALL {
         obj.quad([[2. - h, 0.001, z - h], [2. + h, 0.001, z - h], [2. + h, 0.001, z + h], [2. - h, 0.001, z + h]], [0., 1., 0.], "sensor");
     }
-    for (_, y, _) in CIE_53_FLOOR {
+    for (_, y, _) in cie171::CASE_53_FLOOR {
         obj.quad([[2. - h, y - h, 0.001], [2. + h, y - h, 0.001], [2. + h, y + h, 0.001], [2. - h, y + h, 0.001]], [0., 0., 1.], "sensor");
     }
     std::fs::write(dir.join("cie53.obj"), obj.text).unwrap();
@@ -244,12 +228,12 @@ fn black_sensors_meet_cie_171_case_5_3_at_the_default_settings() {
         }
         e / 9.0
     };
-    let sensors_exact: Vec<f64> = CIE_53_WALL
+    let sensors_exact: Vec<f64> = cie171::CASE_53_WALL
         .iter()
         .map(|&(_, z, _)| mean([2., 0.001, z], [0., 1., 0.], [[1., 0., 0.], [0., 0., 1.]]))
-        .chain(CIE_53_FLOOR.iter().map(|&(_, y, _)| mean([2., y, 0.001], [0., 0., 1.], [[1., 0., 0.], [0., 1., 0.]])))
+        .chain(cie171::CASE_53_FLOOR.iter().map(|&(_, y, _)| mean([2., y, 0.001], [0., 0., 1.], [[1., 0., 0.], [0., 1., 0.]])))
         .collect();
-    let report: Vec<(&str, f64)> = CIE_53_WALL.iter().chain(&CIE_53_FLOOR).map(|&(n, _, v)| (n, v)).collect();
+    let report: Vec<(&str, f64)> = cie171::CASE_53_WALL.iter().chain(&cie171::CASE_53_FLOOR).map(|&(n, _, v)| (n, v)).collect();
     for args in [&[][..], &["--criterion", "irradiance"][..]] {
         let run = solve_file(dir.path(), "cie53.obj", args);
         assert_eq!(run.sensors.len(), report.len());

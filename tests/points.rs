@@ -15,6 +15,9 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
+#[path = "support/cie171.rs"]
+mod cie171;
+
 /// The CIE values in `cie171.md` are printed with 3 decimals: a gather exact up to rounding is
 /// within half of the last digit.
 const REFERENCE_ROUNDING: f64 = 5e-4;
@@ -135,19 +138,7 @@ fn cie_5_3() -> (Scene, Vec<CalcPoint>, Vec<f64>) {
     r.xy((0.0, 1.5), (1.5, 2.5), 3.0, -1.0, k);
     r.xy((2.5, 4.0), (1.5, 2.5), 3.0, -1.0, k);
     r.xy((1.5, 2.5), (1.5, 2.5), 3.0, -1.0, src);
-    let wall =
-        [("A", 2.75, 32.677), ("B", 2.25, 75.194), ("C", 1.75, 81.323), ("D", 1.25, 69.061), ("E", 0.75, 53.404), ("F", 0.25, 40.002)];
-    let floor = [
-        ("G", 0.25, 61.424),
-        ("H", 0.75, 79.255),
-        ("I", 1.25, 95.667),
-        ("J", 1.75, 105.778),
-        ("K", 2.25, 105.778),
-        ("L", 2.75, 95.667),
-        ("M", 3.25, 79.255),
-        ("N", 3.75, 61.424),
-    ];
-    let (pts, exact) = cie_points(&wall, &floor, 0.0, 1.0);
+    let (pts, exact) = cie_points(&cie171::CASE_53_WALL, &cie171::CASE_53_FLOOR, 0.0, 1.0);
     (r.finish(), pts, exact)
 }
 
