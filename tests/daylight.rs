@@ -11,6 +11,12 @@ const BALANCE_TOL: f64 = 0.005;
 /// the largest residual over a pack's three channels, so packs whose third channels differ stop
 /// at slightly different iterates).
 const PACK_TOL: f64 = 1e-9;
+/// Two packs with the same values, refined each on its own light: a pack's links are decided on
+/// the brightest of its three channels, so packs with different third channels get different
+/// meshes, and their powers agree within the balance tolerance of the band's incident light
+/// (measured 0.09% of it on the incident light, whose direct part is integrated over each mesh's
+/// elements, and 0.27% on the escaped light).
+const CROSS_PACK_TOL: f64 = BALANCE_TOL;
 /// Exact cases (an unobstructed plane) agree to rounding.
 const EXACT_TOL: f64 = 1e-9;
 
@@ -151,7 +157,8 @@ fn shaded_two_band_scene_balances_and_reports_every_band() {
 
 #[test]
 fn four_bands_are_two_solves_that_agree_with_one() {
-    // Bands c, d repeat a, b: the second pack must give the first pack's answer.
+    // Bands c, d repeat a, b: c (pack 0's third channel) must give a's answer exactly, d (pack 1's
+    // first) b's within the solve's error.
     let dir = tempfile::tempdir().unwrap();
     let four = SHADED
         .replace("bands = [\"PAR\", \"NIR\"]", "bands = [\"a\", \"b\", \"c\", \"d\"]")
@@ -163,10 +170,12 @@ fn four_bands_are_two_solves_that_agree_with_one() {
         .replace("[100.0, 90.0]", "[100.0, 90.0, 100.0, 90.0]");
     let s = solve(dir.path(), &four);
     let p = &s["power_by_band"];
-    for (x, y) in [("a", "c"), ("b", "d")] {
+    for (x, y, same_pack) in [("a", "c", true), ("b", "d", false)] {
+        let incident = p[x]["incident"].as_f64().unwrap();
         for key in ["incident", "absorbed", "escaped"] {
             let (u, v) = (p[x][key].as_f64().unwrap(), p[y][key].as_f64().unwrap());
-            assert!((u - v).abs() <= PACK_TOL * u.abs(), "{x}/{y} {key}: {u} vs {v}");
+            let bound = if same_pack { PACK_TOL * u.abs() } else { CROSS_PACK_TOL * incident };
+            assert!((u - v).abs() <= bound, "{x}/{y} {key}: {u} vs {v}");
         }
     }
     let (header, rows) = csv(&dir.path().join("out/patches.csv"));

@@ -90,7 +90,7 @@ impl Default for Config {
             use_visibility: true,
             analyse: true,
             visibility_method: VisibilityMethod::Rays,
-            criterion: refine::Criterion::Radiosity,
+            criterion: refine::Criterion::Irradiance,
             final_gather: true,
             leaf_operator_max_bytes: solve::LEAF_OPERATOR_MAX_BYTES,
             stream_leaf_operator: true,
@@ -565,6 +565,8 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
             }
         }
         leaf_entries = leaf.as_ref().map_or(0, solve::LeafCoefficients::entries);
+        // The closure's changes outlive the coefficients, for the estimate.
+        let closure_changes = leaf.as_ref().map_or_else(Vec::new, |c| c.closure_changes().to_vec());
         drop(leaf);
         iterations += more_iterations;
         timings.solve += t.elapsed().as_secs_f64();
@@ -578,7 +580,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let change = history.push(means);
         let last = level + 1 == n_levels || stats.refused_for_memory > 0;
         let estimate = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
-            .then(|| estimate_error(&h, &links, &sol, closed, config, leaf_budget));
+            .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
         let balance_gap = (!h.distant.is_empty() && target_error.is_some()).then(|| crate::daylight::balance_gap(&h, &sol, &caster));
         timings.estimate += t.elapsed().as_secs_f64();
         let report = LevelReport {
@@ -706,14 +708,30 @@ fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solu
 /// the same links solved on the mesh one and two levels coarser ([`solve::Cut::coarsened`]), the
 /// Richardson extrapolation of the three plus what polygons left whole hide from it
 /// ([`solve::unresolved_polygons`]), with the visibility-sampling noise
-/// ([`solve::visibility_noise`]) where that is larger, times [`solve::ESTIMATE_SAFETY`].
-fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, config: &Config, max_bytes: usize) -> f64 {
+/// ([`solve::visibility_noise`]) or the closure's possible misplacement of light
+/// ([`solve::closure_error`], from `closure_changes`, per link) where larger, times
+/// [`solve::ESTIMATE_SAFETY`].
+fn estimate_error(
+    h: &Hierarchy,
+    links: &[Link],
+    sol: &Solution,
+    closed: bool,
+    closure_changes: &[f32],
+    config: &Config,
+    max_bytes: usize,
+) -> f64 {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
     // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
     let irradiance = config.criterion == refine::Criterion::Irradiance;
     let results = crate::output::polygon_results(h, sol);
     let mut means = vec![results.iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
-    let mut h_means = vec![results.iter().map(|r| r.h).collect::<Vec<[f64; 3]>>()];
+    // The irradiance the user reads adds the luminaires' and distant sources' direct light, which
+    // no coarsening changes: it leaves the changes as they are and sets what they are relative to.
+    let direct = direct_polygon_means(h);
+    let with_direct = |results: Vec<crate::output::PolygonResult>| -> Vec<[f64; 3]> {
+        results.iter().enumerate().map(|(p, r)| std::array::from_fn(|c| r.h[c] + direct.get(p).map_or(0.0, |d| d[c]))).collect()
+    };
+    let mut h_means = vec![with_direct(results.clone())];
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
         let coefficients =
@@ -722,7 +740,7 @@ fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, c
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
         let results = crate::output::polygon_results(h, &coarse);
         means.push(results.iter().map(|r| r.b).collect());
-        h_means.push(results.iter().map(|r| r.h).collect());
+        h_means.push(with_direct(results));
     }
     let mut mesh =
         solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
@@ -731,7 +749,27 @@ fn estimate_error(h: &Hierarchy, links: &[Link], sol: &Solution, closed: bool, c
     }
     let kept_rays = config.criterion.kept_rays(config.visibility.rays);
     let noise = solve::visibility_noise(h, links, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()), kept_rays);
-    solve::ESTIMATE_SAFETY * mesh.max(noise) + solve::ESTIMATE_FLOOR
+    let closure = solve::closure_error(h, links, closure_changes, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()));
+    solve::ESTIMATE_SAFETY * mesh.max(noise).max(closure) + solve::ESTIMATE_FLOOR
+}
+
+/// Each polygon's mean direct irradiance from the luminaires and distant sources
+/// ([`Hierarchy::direct`], area-weighted over its leaves); empty without either.
+fn direct_polygon_means(h: &Hierarchy) -> Vec<[f64; 3]> {
+    if h.direct.is_empty() {
+        return Vec::new();
+    }
+    let mut sums = vec![([0.0; 3], 0.0); h.n_polygons as usize];
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        let (Some(p), Some(d)) = (e.polygon(), h.direct.get(leaf as usize)) else { continue };
+        let s = &mut sums[p as usize];
+        s.1 += e.area;
+        for c in 0..3 {
+            s.0[c] += e.area * d[c];
+        }
+    }
+    sums.into_iter().map(|(d, a)| if a > 0.0 { d.map(|v| v / a) } else { [0.0; 3] }).collect()
 }
 
 /// The visibility method a solve with `oracle` uses: `requested`, except that an oracle that needs

@@ -27,7 +27,7 @@ pub struct AccuracyBenchArgs {
     #[arg(long)]
     pub json: bool,
     /// What the link criteria bound the error of (as `radiosity solve --criterion`).
-    #[arg(long, default_value = "radiosity", value_parser = ["radiosity", "irradiance"])]
+    #[arg(long, default_value = "irradiance", value_parser = ["radiosity", "irradiance"])]
     pub criterion: String,
     /// Internal: solve one case (`NAME EPS CRITERION`, EPS `target` for the default target error)
     /// and print its row as JSON.

@@ -112,7 +112,7 @@ pub struct CommonOptions {
     /// What the link criteria bound the error of: `radiosity` (B = E + ρH: a shadow within a
     /// receiver counts in proportion to its reflectance) or `irradiance` (H, whatever the
     /// reflectance: black sensors and dark floors refined like white walls).
-    #[arg(long, default_value = "radiosity", value_parser = ["radiosity", "irradiance"])]
+    #[arg(long, default_value = "irradiance", value_parser = ["radiosity", "irradiance"])]
     pub criterion: String,
     /// Memory refinement may use, MB (default: half the machine's physical memory): beyond it no
     /// link is subdivided any more, and stats.json says so.

@@ -9,10 +9,10 @@ use crate::visibility::{RayCaster, VisibilityConfig};
 pub enum Criterion {
     /// The radiosity `B = E + ρ·H`: how a shadow falls within a receiver counts in proportion to
     /// its reflectance, so a black receiver's irradiance is never refined for a shadow.
-    #[default]
     Radiosity,
     /// The irradiance `H`, whatever the receiver's reflectance: a black sensor's penumbra is
-    /// refined like a white wall's (lux and absorbed power follow from `H`).
+    /// refined like a white wall's (lux and absorbed power follow from `H`). The default.
+    #[default]
     Irradiance,
 }
 

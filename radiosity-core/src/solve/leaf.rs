@@ -202,6 +202,8 @@ pub struct LeafCoefficients {
     shared: Vec<(ElementId, usize, usize)>,
     /// Smallest and largest closure factor applied ([`LeafCoefficients::closure`]).
     closure: (f64, f64),
+    /// Per link, the closure factor on its transfer less 1 (empty in an open scene).
+    closure_change: Vec<f32>,
 }
 
 /// Smallest closure factor of one unknown: delivering more than twice its light means something
@@ -543,6 +545,7 @@ impl LeafCoefficients {
             weight,
             shared,
             closure: (1.0, 1.0),
+            closure_change: Vec::new(),
         };
         if closed {
             c.close(cut, &transfer);
@@ -556,6 +559,13 @@ impl LeafCoefficients {
     #[must_use]
     pub fn closure(&self) -> (f64, f64) {
         self.closure
+    }
+
+    /// Per link (in the order of the links given), the factor the closure applied to the light
+    /// it carries, less 1; empty in an open scene. See [`super::closure_error`].
+    #[must_use]
+    pub fn closure_changes(&self) -> &[f32] {
+        &self.closure_change
     }
 
     /// In a closed scene every bit of light leaving a surface lands on another, so the fractions of
@@ -619,12 +629,15 @@ impl LeafCoefficients {
                 rescale(lo, hi)
             })
             .collect();
+        self.closure_change = Vec::with_capacity(self.scale.len());
         for ((s, v), own) in self.scale.iter_mut().zip(&self.value).zip(&own_scale) {
-            *s *= match *v {
+            let m = match *v {
                 SourceValue::Leaf(e) => f(e),
                 SourceValue::Own(..) => own.unwrap_or(1.0),
                 SourceValue::Shared(i) => shared_scale[i as usize],
             };
+            *s *= m;
+            self.closure_change.push((m - 1.0) as f32);
         }
         let (lo, hi) = factor.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
         self.closure = if factor.is_empty() { (1.0, 1.0) } else { (lo, hi) };

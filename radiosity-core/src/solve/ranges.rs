@@ -53,7 +53,10 @@ pub fn element_data(h: &Hierarchy, links: &[Link], sol: &Solution) -> ElementDat
     for (&leaf, &(l, u)) in leaves.iter().zip(&leaf_ranges) {
         lo[leaf as usize] = l;
         hi[leaf as usize] = u;
-        let hl = max3(sol.irradiance[leaf as usize]);
+        // What the leaf receives in all: the links' light and the luminaires' and distant
+        // sources' direct light, which the user reads in the same number.
+        let direct = h.direct.get(leaf as usize).copied().unwrap_or_default();
+        let hl = max3(std::array::from_fn(|c| sol.irradiance[leaf as usize][c] + direct[c]));
         irradiance[leaf as usize] = hl;
         let a = h.get(leaf).area;
         h_sum += a * hl;

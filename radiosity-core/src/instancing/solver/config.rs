@@ -222,9 +222,12 @@ pub(super) const LOCAL_PASSES: usize = 3;
 
 /// Settings of every local solve (and of the full solve it is compared with): one level of the
 /// classic BF oracle ([`ClassicBf`](crate::refine::ClassicBf)), no variation measured, no estimate, no closure (a local
-/// problem is open to the rest of the scene).
+/// problem is open to the rest of the scene), and the radiosity criterion whatever
+/// `config.pipeline` says: the level cache, the proxies and their measured errors are the classic
+/// criterion's (`--criterion` is for plain scenes).
 pub(super) fn local_pipeline(config: &InstancedConfig) -> pipeline::Config {
     pipeline::Config {
+        criterion: crate::refine::Criterion::Radiosity,
         estimate_error: false,
         detect_closure: false,
         levels: 1,
