@@ -34,7 +34,7 @@ fn means(solved: &Solved) -> Vec<[f64; 3]> {
 }
 
 fn balance(solved: &Solved) -> f64 {
-    let (emitted, absorbed, _) = radiosity::output::power_balance(&solved.hierarchy, &solved.solution);
+    let (emitted, absorbed, _) = radiosity::output::power_balance(&solved.hierarchy, &solved.lights, &solved.solution);
     absorbed / emitted
 }
 

@@ -28,7 +28,7 @@ fn assert_finite(s: &Solved) {
 }
 
 fn assert_balanced(s: &Solved) {
-    let (emitted, absorbed, _) = power_balance(&s.hierarchy, &s.solution);
+    let (emitted, absorbed, _) = power_balance(&s.hierarchy, &s.lights, &s.solution);
     assert!((absorbed / emitted - 1.0).abs() < BALANCE_REL_TOL, "emitted {emitted:e}, absorbed {absorbed:e}");
 }
 

@@ -76,7 +76,7 @@ fn cie171_5_4_flux_is_conserved() {
         let received = luminaire::flux_received(&solved.hierarchy);
         let ratio = received / lum.flux();
         assert!((ratio - 1.0).abs() <= FLUX_TOL, "at {at}: received / emitted = {ratio}");
-        let (emitted, absorbed, _) = radiosity::output::power_balance(&solved.hierarchy, &solved.solution);
+        let (emitted, absorbed, _) = radiosity::output::power_balance(&solved.hierarchy, &solved.lights, &solved.solution);
         assert!((absorbed / emitted - 1.0).abs() <= FLUX_TOL, "at {at}: balance {}", absorbed / emitted);
     }
 }
@@ -96,7 +96,7 @@ fn closed_grey_room_conserves_energy() {
     );
     let solved = solve(&scene);
     let h = &solved.hierarchy;
-    let (emitted, absorbed, _) = radiosity::output::power_balance(h, &solved.solution);
+    let (emitted, absorbed, _) = radiosity::output::power_balance(h, &solved.lights, &solved.solution);
     assert!((absorbed / emitted - 1.0).abs() <= FLUX_TOL, "balance {}", absorbed / emitted);
     let leaving: f64 =
         h.leaves().filter_map(|l| h.get(l).polygon().map(|_| h.get(l).area * solved.solution.radiosity[l as usize][0])).sum();

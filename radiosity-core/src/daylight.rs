@@ -24,26 +24,7 @@ use crate::geom::DVec3;
 use crate::hierarchy::NONE;
 use crate::visibility::RayCaster;
 
-/// A field of parallel beams.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DistantSource {
-    /// Unit direction the light travels (toward the ground for the sun).
-    pub toward: DVec3,
-    /// Irradiance on a plane facing the beam, per channel (W/m²).
-    pub irradiance: [f64; 3],
-    /// Whether the source is small enough to cast sharp shadows (the sun): surfaces are split
-    /// along its shadow boundaries before the solve, as for a luminaire.
-    pub sharp: bool,
-}
-
-impl DistantSource {
-    /// Irradiance on a surface with unit normal `n`, unoccluded.
-    #[must_use]
-    pub fn on(&self, n: DVec3) -> [f64; 3] {
-        let cos = -n.dot(self.toward);
-        if cos <= 0.0 { [0.0; 3] } else { self.irradiance.map(|e| e * cos) }
-    }
-}
+pub use crate::light::DistantSource;
 
 /// Which way is up and which is north in the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -256,6 +237,12 @@ pub struct DistantLight<'a> {
 }
 
 impl<'a> DistantLight<'a> {
+    /// The sources seen.
+    #[must_use]
+    pub fn sources(&self) -> &'a [DistantSource] {
+        self.sources
+    }
+
     /// `caster` `None`: no occlusion.
     #[must_use]
     pub fn new(sources: &'a [DistantSource], caster: Option<&'a RayCaster>, scene_diagonal: f64) -> DistantLight<'a> {
@@ -488,17 +475,22 @@ pub fn power_leaving(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], ca
 /// over their leaves, a shadow ray per quadrature point and source from the back), blocked there
 /// and lost; and that power per polygon, summed over channels (empty when none).
 #[must_use]
-pub fn power_incident_on_backs(h: &crate::hierarchy::Hierarchy, caster: &RayCaster, open_back: &[bool]) -> ([f64; 3], Vec<f64>) {
+pub fn power_incident_on_backs(
+    h: &crate::hierarchy::Hierarchy,
+    distant: &[DistantSource],
+    caster: &RayCaster,
+    open_back: &[bool],
+) -> ([f64; 3], Vec<f64>) {
     use rayon::prelude::*;
-    if h.distant.is_empty() || !open_back.iter().any(|&o| o) {
+    if distant.is_empty() || !open_back.iter().any(|&o| o) {
         return ([0.0; 3], Vec::new());
     }
-    let light = DistantLight::new(&h.distant, Some(caster), h.diagonal());
+    let light = DistantLight::new(distant, Some(caster), h.diagonal());
     let leaves: Vec<u32> = h
         .leaves()
         .filter(|&l| {
             let e = h.get(l);
-            e.polygon().is_some_and(|p| open_back[p as usize]) && h.distant.iter().any(|s| s.on(-e.normal).iter().any(|&v| v > 0.0))
+            e.polygon().is_some_and(|p| open_back[p as usize]) && distant.iter().any(|s| s.on(-e.normal).iter().any(|&v| v > 0.0))
         })
         .collect();
     let per_leaf: Vec<(u32, [f64; 3])> = leaves
@@ -544,10 +536,15 @@ pub struct OutsideLinks {
 /// [`OutsideLinks`] of a solution: [`power_incident`], [`power_incident_on_backs`] and
 /// [`power_leaving`] together.
 #[must_use]
-pub fn outside_links(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], caster: &RayCaster) -> OutsideLinks {
+pub fn outside_links(
+    h: &crate::hierarchy::Hierarchy,
+    distant: &[DistantSource],
+    radiosity: &[[f64; 3]],
+    caster: &RayCaster,
+) -> OutsideLinks {
     let open_back = open_backs(h);
     let front = power_incident(h);
-    let (on_backs, on_backs_by) = power_incident_on_backs(h, caster, &open_back);
+    let (on_backs, on_backs_by) = power_incident_on_backs(h, distant, caster, &open_back);
     let leaving = power_leaving(h, radiosity, caster, &open_back);
     let lost_by_polygon = match (on_backs_by.is_empty(), leaving.onto_backs_by_polygon.is_empty()) {
         (true, _) => leaving.onto_backs_by_polygon,
@@ -567,8 +564,13 @@ pub fn outside_links(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], ca
 /// without the direct light. Light landing on the back of a one-sided face (from the sources or
 /// the surfaces) counts as incident and lost, as in `stats.json`.
 #[must_use]
-pub fn balance_gap(h: &crate::hierarchy::Hierarchy, solution: &crate::solve::Solution, caster: &RayCaster) -> f64 {
-    let outside = outside_links(h, &solution.radiosity, caster);
+pub fn balance_gap(
+    h: &crate::hierarchy::Hierarchy,
+    distant: &[DistantSource],
+    solution: &crate::solve::Solution,
+    caster: &RayCaster,
+) -> f64 {
+    let outside = outside_links(h, distant, &solution.radiosity, caster);
     let incident = outside.incident;
     let escaped: [f64; 3] = std::array::from_fn(|c| outside.escaped[c] + outside.lost_at_backs[c]);
     let (mut absorbed, mut emitted) = ([0.0; 3], [0.0; 3]);

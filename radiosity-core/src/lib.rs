@@ -21,6 +21,7 @@ pub mod formfactor;
 pub mod geom;
 pub mod hierarchy;
 pub mod instancing;
+pub mod light;
 pub mod luminaire;
 pub mod oracle;
 pub mod output;

@@ -375,6 +375,9 @@ pub const BALANCE_GAP_MIN_FALL: f64 = 0.1;
 pub struct Solved {
     /// The element hierarchy.
     pub hierarchy: Hierarchy,
+    /// The scene's luminaires and distant sources, whose direct light is in
+    /// [`Hierarchy::direct`].
+    pub lights: crate::light::Lights,
     /// Final links.
     pub links: Vec<Link>,
     /// Final solution.
@@ -439,12 +442,13 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let use_visibility = config.use_visibility && traits.as_ref().is_none_or(|t| t.needs_visibility);
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
+    let lights = scene.lights();
     // Luminaires: surfaces split for their light, every element's direct illuminance.
-    crate::luminaire::prepare(&mut h, config.use_visibility.then_some(&caster));
+    crate::luminaire::prepare(&mut h, &lights, config.use_visibility.then_some(&caster));
     // Both sides of a transmitting leaf are cut into the same pieces (here and after every
     // refinement), so each piece passes its light through to the piece behind it.
     if !h.match_sides().is_empty() {
-        crate::luminaire::update_direct(&mut h, config.use_visibility.then_some(&caster));
+        crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
     }
     let shaft_objects = match effective_visibility(oracle, config.visibility_method) {
         VisibilityMethod::Shafts(volume) if use_visibility => Some(crate::visibility::shaft::ShaftObjects::new(
@@ -522,7 +526,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
                 s.form_factors += form_factors;
                 s.links = links.len() as u64;
             }
-            crate::luminaire::update_direct(&mut h, config.use_visibility.then_some(&caster));
+            crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
             timings.refine += t.elapsed().as_secs_f64();
             stats.oracle_calls += s.oracle_calls;
             stats.form_factors += s.form_factors;
@@ -581,7 +585,8 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let last = level + 1 == n_levels || stats.refused_for_memory > 0;
         let estimate = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
-        let balance_gap = (!h.distant.is_empty() && target_error.is_some()).then(|| crate::daylight::balance_gap(&h, &sol, &caster));
+        let balance_gap = (!lights.distant.is_empty() && target_error.is_some())
+            .then(|| crate::daylight::balance_gap(&h, &lights.distant, &sol, &caster));
         timings.estimate += t.elapsed().as_secs_f64();
         let report = LevelReport {
             balance_gap,
@@ -666,6 +671,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     let shaft_classified = [shaft_invisible.load(Ordering::Relaxed), shaft_visible.load(Ordering::Relaxed)];
     Solved {
         hierarchy: h,
+        lights,
         links,
         solution,
         caster,

@@ -172,7 +172,7 @@ fn child(name: &str, eps: &str, criterion: &str) -> anyhow::Result<()> {
     let time = t0.elapsed().as_secs_f64();
     let results = radiosity::output::polygon_results(&solved.hierarchy, &solved.solution);
     let means: Vec<[f64; 3]> = results.iter().map(|r| r.b).collect();
-    let (emitted, absorbed, _) = radiosity::output::power_balance(&solved.hierarchy, &solved.solution);
+    let (emitted, absorbed, _) = radiosity::output::power_balance(&solved.hierarchy, &solved.lights, &solved.solution);
     let class_errors = (name == "ward-room").then(|| {
         WARD_CLASSES
             .iter()

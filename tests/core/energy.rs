@@ -29,7 +29,7 @@ fn closed_room_with_an_occluding_block_balances() {
     }
     let scene = b.finish();
     let solved = solve(&scene, 0.01, 1e-3);
-    let (emitted, absorbed, _) = power_balance(&solved.hierarchy, &solved.solution);
+    let (emitted, absorbed, _) = power_balance(&solved.hierarchy, &solved.lights, &solved.solution);
     println!("emitted {emitted:.6} W, absorbed {absorbed:.6} W, {} links, {} rays", solved.links.len(), solved.rays);
     assert!(solved.rays > 0, "the block must make the solve cast rays");
     assert!((absorbed / emitted - 1.0).abs() < BALANCE_REL_TOL, "emitted {emitted}, absorbed {absorbed}");
@@ -88,7 +88,7 @@ fn closed_room_with_a_transmitting_leaf_balances() {
     b.quad("leaf", [front[3], front[2], front[1], front[0]], leaf);
     let scene = b.finish();
     let solved = solve(&scene, 0.01, 1e-3);
-    let (emitted, absorbed, _) = power_balance(&solved.hierarchy, &solved.solution);
+    let (emitted, absorbed, _) = power_balance(&solved.hierarchy, &solved.lights, &solved.solution);
     println!("emitted {emitted:.6} W, absorbed {absorbed:.6} W");
     assert!((absorbed / emitted - 1.0).abs() < BALANCE_REL_TOL, "emitted {emitted}, absorbed {absorbed}");
 }

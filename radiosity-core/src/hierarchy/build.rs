@@ -80,8 +80,6 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         transmittance,
         twin,
         min_area: config.min_area_rel * total_area,
-        luminaires: scene.luminaires.clone(),
-        distant: scene.distant.clone(),
         direct: Vec::new(),
     };
     let centroids: Vec<DVec3> = h.elements.iter().map(|e| e.center).collect();

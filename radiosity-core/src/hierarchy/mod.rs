@@ -121,15 +121,9 @@ pub struct Hierarchy {
     pub twin: Vec<u32>,
     /// Smallest area a surface element may be subdivided into.
     pub min_area: f64,
-    /// The scene's luminaires (photometric point sources), whose light enters through
-    /// [`Hierarchy::direct`].
-    pub luminaires: Vec<crate::luminaire::Luminaire>,
-    /// The scene's distant sources (sun and sky), whose light enters through
-    /// [`Hierarchy::direct`] like the luminaires'.
-    pub distant: Vec<crate::daylight::DistantSource>,
-    /// Direct irradiance from the luminaires and distant sources per element and channel (the area
-    /// mean over the element), filled by [`crate::luminaire::update_direct`]; empty without
-    /// either.
+    /// Direct irradiance from the scene's luminaires and distant sources (which the hierarchy
+    /// does not hold: [`crate::light::Lights`]) per element and channel (the area mean over the
+    /// element), filled by [`crate::luminaire::update_direct`]; empty without either.
     pub direct: Vec<[f64; 3]>,
 }
 
@@ -294,12 +288,6 @@ impl Hierarchy {
         let mate = self.mate(id);
         let other = if mate == NONE { [0.0; 3] } else { self.direct.get(mate as usize).copied().unwrap_or_default() };
         std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d[c] + self.transmittance[p][c] * other[c])
-    }
-
-    /// Whether light enters other than through emitting polygons: luminaires or distant sources.
-    #[must_use]
-    pub fn has_direct_sources(&self) -> bool {
-        !self.luminaires.is_empty() || !self.distant.is_empty()
     }
 
     /// The length of the diagonal of the scene's bounding box.

@@ -205,7 +205,7 @@ pub fn channel_powers(solved: &crate::pipeline::Solved) -> [BandPower; 3] {
 pub fn channel_powers_and_losses(solved: &crate::pipeline::Solved) -> ([BandPower; 3], Vec<f64>) {
     let h = &solved.hierarchy;
     let mut out = [BandPower::default(); 3];
-    let lum: f64 = h.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum();
+    let lum: f64 = solved.lights.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum();
     for leaf in h.leaves() {
         let e = h.get(leaf);
         let Some(p) = e.polygon() else { continue };
@@ -217,8 +217,8 @@ pub fn channel_powers_and_losses(solved: &crate::pipeline::Solved) -> ([BandPowe
         }
     }
     let mut lost_by_polygon = Vec::new();
-    if !h.distant.is_empty() {
-        let outside = crate::daylight::outside_links(h, &solved.solution.radiosity, &solved.caster);
+    if !solved.lights.distant.is_empty() {
+        let outside = crate::daylight::outside_links(h, &solved.lights.distant, &solved.solution.radiosity, &solved.caster);
         for c in 0..3 {
             out[c].incident = outside.incident[c];
             out[c].escaped = outside.escaped[c];
@@ -292,7 +292,7 @@ pub fn peak_rss_bytes() -> Option<u64> {
 /// `(emitted, absorbed, mean radiosity)`: emitted and absorbed power per channel mean, and the
 /// area-weighted mean leaf radiosity.
 #[must_use]
-pub fn power_balance(h: &Hierarchy, solution: &Solution) -> (f64, f64, [f64; 3]) {
+pub fn power_balance(h: &Hierarchy, lights: &crate::light::Lights, solution: &Solution) -> (f64, f64, [f64; 3]) {
     let mut emitted = 0.0;
     let mut absorbed = 0.0;
     let mut mean = [0.0; 3];
@@ -311,7 +311,7 @@ pub fn power_balance(h: &Hierarchy, solution: &Solution) -> (f64, f64, [f64; 3])
         area += e.area;
     }
     // The luminaires' light (every channel the same luminous flux).
-    emitted += h.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum::<f64>();
+    emitted += lights.luminaires.iter().map(crate::luminaire::Luminaire::flux).sum::<f64>();
     (emitted, absorbed, mean.map(|m| if area > 0.0 { m / area } else { 0.0 }))
 }
 
@@ -328,7 +328,7 @@ impl Stats {
     ) -> Stats {
         let (load, output, total) = times;
         let h = &solved.hierarchy;
-        let (power_emitted, power_absorbed, radiosity_mean) = power_balance(h, &solved.solution);
+        let (power_emitted, power_absorbed, radiosity_mean) = power_balance(h, &solved.lights, &solved.solution);
         let mut stats = Stats {
             scene: scene.name.clone(),
             oracle: oracle.to_string(),
@@ -382,7 +382,8 @@ impl Stats {
             points: None,
             point_rays: None,
             units: scene.units,
-            luminaires: h
+            luminaires: solved
+                .lights
                 .luminaires
                 .iter()
                 .map(|l| LuminaireStats {
@@ -393,7 +394,7 @@ impl Stats {
                 .collect(),
             grids: None,
         };
-        if !h.distant.is_empty() {
+        if !solved.lights.distant.is_empty() {
             let (per, lost_by_polygon) = channel_powers_and_losses(solved);
             stats.set_band_powers(&crate::output::csv::RGB, &per, true);
             stats.solve_warnings.extend(lost_at_backs_warning(scene, &per, &lost_by_polygon));

@@ -129,6 +129,9 @@ pub struct PointGather<'a> {
     /// Rays are cast only for points outside the enclosure.
     convex_enclosure: bool,
     shadow_depth: u32,
+    /// The luminaires and distant sources whose direct light the point gets besides the
+    /// surfaces' (none unless set, as [`PointGather::for_solved`] does).
+    lights: Option<&'a crate::light::Lights>,
 }
 
 impl<'a> PointGather<'a> {
@@ -156,15 +159,18 @@ impl<'a> PointGather<'a> {
             scale: bounds.diagonal(),
             convex_enclosure: false,
             shadow_depth: config.shadow_depth,
+            lights: None,
         }
     }
 
-    /// Prepares the gather from a solve's hierarchy, radiosity and caster. When the solve's
-    /// analysis found a convex enclosure (no visibility needed), points inside it cast no ray.
+    /// Prepares the gather from a solve's hierarchy, radiosity, caster and lights. When the
+    /// solve's analysis found a convex enclosure (no visibility needed), points inside it cast no
+    /// ray.
     #[must_use]
     pub fn for_solved(solved: &'a Solved, config: &PointsConfig) -> PointGather<'a> {
         let mut g = PointGather::new(&solved.hierarchy, &solved.solution.radiosity, Some(&solved.caster), config);
         g.convex_enclosure = solved.traits.as_ref().is_some_and(|t| !t.needs_visibility);
+        g.lights = Some(&solved.lights);
         g
     }
 
@@ -230,7 +236,8 @@ impl<'a> PointGather<'a> {
         // Luminaires: their intensity toward the point, from the point's side of every surface it
         // lies on, with one shadow ray each (cast whenever rays are, inside a convex room too: a
         // luminaire may stand outside it).
-        for lum in &self.h.luminaires {
+        let (luminaires, distant) = self.lights.map_or((&[][..], &[][..]), |l| (&l.luminaires[..], &l.distant[..]));
+        for lum in luminaires {
             if (0..sides.len).any(|k| sides.normals[k].dot(lum.position - x) <= 0.0) {
                 continue;
             }
@@ -251,7 +258,7 @@ impl<'a> PointGather<'a> {
         // Distant sources (sun, sky cells): their beam, from the point's side of every surface it
         // lies on, with one shadow ray each.
         let far = crate::daylight::FAR_REL * self.scale;
-        for s in &self.h.distant {
+        for s in distant {
             if (0..sides.len).any(|k| sides.normals[k].dot(s.toward) >= 0.0) {
                 continue;
             }

@@ -195,6 +195,12 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
 }
 
 impl Scene {
+    /// The scene's light sources besides its emitting polygons (copies).
+    #[must_use]
+    pub fn lights(&self) -> crate::light::Lights {
+        crate::light::Lights { luminaires: self.luminaires.clone(), distant: self.distant.clone() }
+    }
+
     /// Validation common to every format: non-empty, at least one emitter unless `allow_dark`.
     pub fn check(&self, path: &Path, options: &LoadOptions) -> Result<(), SceneError> {
         if self.polygons.is_empty() {
