@@ -66,8 +66,12 @@ fn floor_strip_through_the_cie_points_has_the_figures_computed_by_hand() {
     let results = points::gather(&solved, &grid.points, &PointsConfig::default());
     let values: Vec<f64> = results.iter().map(points::PointIrradiance::photopic).collect();
     let exact = [61.424, 79.255, 95.667, 105.778, 105.778, 95.667, 79.255, 61.424];
-    for (v, e) in values.iter().zip(exact) {
+    for ((v, e), r) in values.iter().zip(exact).zip(&results) {
         assert!((v - e).abs() <= REFERENCE_ROUNDING + EXACT_REL_TOL * e, "{v} vs {e}");
+        // Its estimated error: finite, within 1% of the value, and covering the true error.
+        let err = r.photopic_err();
+        assert!(err.is_finite() && err <= 0.01 * e, "{v}: estimated error {err}");
+        assert!((v - e).abs() <= err + REFERENCE_ROUNDING, "{v} vs {e}, estimated error {err}");
     }
     // By hand: the mean of the four distinct values, 342.124 / 4; U0 = 61.424 / 85.531.
     let s = GridSummary::of(&values).unwrap();
@@ -83,16 +87,16 @@ fn floor_strip_through_the_cie_points_has_the_figures_computed_by_hand() {
     let csv = String::from_utf8(csv).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 9);
-    assert_eq!(rows[0], "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,e_lx,units");
+    assert_eq!(rows[0], "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,e_lx,units,h_err,e_err");
     assert!(rows[1].starts_with("cie_0_0,2,0.25,0,0,0,1,"), "{}", rows[1]);
     assert!(rows[4].starts_with("cie_0_3,2,1.75,0,0,0,1,"), "{}", rows[4]);
     let fields: Vec<f64> = rows[4].split(',').skip(7).take(5).map(|f| f.parse().unwrap()).collect();
     assert_eq!(fields.len(), 5);
-    assert!(rows[4].ends_with(",lm/m2"), "{}", rows[4]);
+    assert!(rows[4].split(',').nth(12) == Some("lm/m2"), "{}", rows[4]);
     assert!(fields.iter().all(|f| (f - 105.778).abs() <= REFERENCE_ROUNDING), "{}", rows[4]);
     let mut csv = Vec::new();
     write_grid_csv(&mut csv, &grid, &results, Units::Radiometric).unwrap();
-    assert!(String::from_utf8(csv).unwrap().starts_with("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units\n"));
+    assert!(String::from_utf8(csv).unwrap().starts_with("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units,h_err\n"));
 }
 
 #[test]
@@ -166,7 +170,7 @@ fn cli_grid_on_the_cornell_box_writes_csv_svg_and_stats() {
     assert!(stdout.lines().any(|l| l.starts_with("grid work: 9 points, h_photopic avg ")), "{stdout}");
     let csv = std::fs::read_to_string(dir.path().join("o/grid_x.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
-    assert_eq!(rows[0], "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units");
+    assert_eq!(rows[0], "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units,h_err");
     assert_eq!(rows.len(), 7);
     assert!(rows[1].starts_with("x_0_0,150,1,450,0,1,0,"), "{}", rows[1]);
     assert!(rows[6].starts_with("x_2_1,350,1,510,0,1,0,"), "{}", rows[6]);
@@ -175,8 +179,11 @@ fn cli_grid_on_the_cornell_box_writes_csv_svg_and_stats() {
     assert!(dir.path().join("o/grid_work.svg").is_file());
     let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/stats.json")).unwrap()).unwrap();
     let x = &stats["grids"]["x"];
-    let photopic: Vec<f64> = rows[1..].iter().map(|r| r.rsplit(',').nth(1).unwrap().parse().unwrap()).collect();
-    let want = GridSummary::of(&photopic).unwrap();
+    let column = |r: &str, k: usize| -> f64 { r.split(',').nth(k).unwrap().parse().unwrap() };
+    let photopic: Vec<f64> = rows[1..].iter().map(|r| column(r, 10)).collect();
+    let errors: Vec<f64> = rows[1..].iter().map(|r| column(r, 12)).collect();
+    let want = GridSummary::of(&photopic).unwrap().with_errors(&errors);
+    assert_eq!(x["e_err_max"].as_f64().unwrap(), want.e_err_max.unwrap(), "the worst point's estimated error");
     assert_eq!(x["points"], 6);
     // stats.json and the CSV agree (`{:e}` prints the shortest text that reads back exactly).
     assert_eq!(x["e_min"].as_f64().unwrap(), want.e_min);

@@ -385,17 +385,19 @@ fn cli_writes_points_csv_in_input_order() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let csv = std::fs::read_to_string(dir.path().join("o/points.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units"));
+    assert_eq!(lines.next(), Some("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units,h_err"));
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 3, "{csv}");
     assert!(rows[0].starts_with("floor under the lamp,278,0,280,0,1,0,"), "normal written normalised: {}", rows[0]);
     assert!(rows[1].starts_with("\"back of the ceiling, up\","), "{}", rows[1]);
-    let values = |row: &str| -> Vec<f64> { row.rsplit(',').skip(1).take(4).map(|v| v.parse().unwrap()).collect::<Vec<_>>() };
+    let values = |row: &str| -> Vec<f64> { row.rsplit(',').skip(2).take(4).map(|v| v.parse().unwrap()).collect::<Vec<_>>() };
+    let error = |row: &str| -> f64 { row.rsplit(',').next().unwrap().parse().unwrap() };
     for row in [rows[0], rows[2]] {
         let v = values(row); // photopic, b, g, r
         assert!(v.iter().all(|&h| h > 0.0), "a point facing the lit room gets light: {row}");
         let photopic = 0.2126 * v[3] + 0.7152 * v[2] + 0.0722 * v[1];
         assert!((v[0] - photopic).abs() <= 1e-12 * photopic, "Rec. 709 weights: {row}");
+        assert!(error(row) > 0.0 && error(row) < v[0], "an estimated error, below the value: {row}");
     }
     assert!(values(rows[1]).iter().all(|&h| h == 0.0), "above the ceiling nothing is lit: {}", rows[1]);
     let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/stats.json")).unwrap()).unwrap();

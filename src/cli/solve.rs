@@ -496,8 +496,9 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
     let (column, unit) = (radiosity::points::grid::photopic_column(units), radiosity::points::grid::photopic_unit(units));
     let mut grid_files = String::new();
     for (name, g) in s.grids.iter().flatten() {
+        let err = g.e_err_max.map_or_else(String::new, |e| format!(", estimated error at most {e:.2e} {unit}"));
         println!(
-            "grid {name}: {} points, {column} avg {:.4e} {unit}, min {:.4e}, max {:.4e}, U0 {:.3}, min/max {:.3}",
+            "grid {name}: {} points, {column} avg {:.4e} {unit}, min {:.4e}, max {:.4e}, U0 {:.3}, min/max {:.3}{err}",
             g.points, g.e_avg, g.e_min, g.e_max, g.u0, g.min_over_max
         );
         grid_files.push_str(&format!(",grid_{name}.csv,grid_{name}.svg"));
@@ -518,8 +519,10 @@ fn write_grids(
     for (g, r) in grids.iter().zip(results) {
         let name = &g.spec.name;
         let values: Vec<f64> = r.iter().map(radiosity::points::PointIrradiance::photopic).collect();
+        let errors: Vec<f64> = r.iter().map(radiosity::points::PointIrradiance::photopic_err).collect();
         let summary = radiosity::points::GridSummary::of(&values)
-            .with_context(|| format!("grid `{name}`: no point, or a value that is not finite"))?;
+            .with_context(|| format!("grid `{name}`: no point, or a value that is not finite"))?
+            .with_errors(&errors);
         let path = out.join(format!("grid_{name}.csv"));
         output::atomic::write_file(&path, |w| output::write_grid_csv(w, g, r, units))
             .with_context(|| format!("{}: cannot write", path.display()))?;

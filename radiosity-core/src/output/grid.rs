@@ -21,7 +21,7 @@ const PLOT_HEIGHT_RANGE: (f64, f64) = (240.0, 900.0);
 const HULL_TOL_CELLS: f64 = 1e-9;
 
 /// Writes `grid_<name>.csv`: the grid's points in its order, in the columns of `points.csv`
-/// ([`super::write_points_csv_in`]: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units`).
+/// ([`super::write_points_csv_in`]: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units,h_err[,e_err]`).
 pub fn write_grid_csv(w: &mut impl Write, grid: &Grid, results: &[PointIrradiance], units: Units) -> std::io::Result<()> {
     super::write_points_csv_in(w, &grid.points, results, units)
 }

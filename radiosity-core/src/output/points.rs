@@ -1,6 +1,8 @@
 //! `points.csv` (with `radiosity solve --points FILE`): one row per calculation point, in input
-//! order: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units` (`e_lx` in photometric scenes;
-//! `units` is `W/m2` or `lm/m2`).
+//! order: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units,h_err[,e_err]` (`e_lx` in
+//! photometric scenes; `units` is `W/m2` or `lm/m2`; `h_err` the estimated error of `h_photopic`
+//! in its units and `e_err` of `e_lx`, see [`crate::points::PointGather`]; `NaN` when the solve
+//! has no error estimate).
 
 use super::csv_field;
 use crate::photometry::Units;
@@ -9,7 +11,7 @@ use std::io::Write;
 
 /// Writes `points.csv`: each point's name, position, unit normal (as gathered: the input normal
 /// normalised), irradiance per channel (W/m²) and its photopic value
-/// ([`crate::points::PHOTOPIC_WEIGHTS`]).
+/// ([`crate::points::PHOTOPIC_WEIGHTS`]), then the photopic value's estimated error.
 pub fn write_points_csv(w: &mut impl Write, points: &[CalcPoint], results: &[PointIrradiance]) -> std::io::Result<()> {
     write_points_csv_in(w, points, results, Units::Radiometric)
 }
@@ -18,14 +20,17 @@ pub fn write_points_csv(w: &mut impl Write, points: &[CalcPoint], results: &[Poi
 /// (the photopic value, lx) too.
 pub fn write_points_csv_in(w: &mut impl Write, points: &[CalcPoint], results: &[PointIrradiance], units: Units) -> std::io::Result<()> {
     let photometric = units == Units::Photometric;
-    writeln!(w, "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic{},units", if photometric { ",e_lx" } else { "" })?;
+    let (lux, lux_err) = if photometric { (",e_lx", ",e_err") } else { ("", "") };
+    writeln!(w, "name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic{lux},units,h_err{lux_err}")?;
     let label = units.density_label();
     for (p, r) in points.iter().zip(results) {
         let (x, n) = (p.position, p.normal);
         let lux = if photometric { format!(",{:e}", r.photopic()) } else { String::new() };
+        let err = r.photopic_err();
+        let lux_err = if photometric { format!(",{err:e}") } else { String::new() };
         writeln!(
             w,
-            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e}{lux},{label}",
+            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e}{lux},{label},{err:e}{lux_err}",
             csv_field(&p.name),
             x.x,
             x.y,

@@ -108,6 +108,9 @@ pub struct GridSummary {
     pub u0: f64,
     /// e_min / e_max (0 when e_max is 0).
     pub min_over_max: f64,
+    /// The largest estimated error of a point's value, same unit (`None`: not estimated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub e_err_max: Option<f64>,
 }
 
 /// The name of the photopic column of `grid_<name>.csv` (and of the figures): `e_lx` in
@@ -131,7 +134,7 @@ pub fn photopic_unit(units: Units) -> &'static str {
 
 impl GridSummary {
     /// The figures of `values` (the photopic value of each point); `None` when there is none or
-    /// one is not finite.
+    /// one is not finite. Without errors: [`GridSummary::with_errors`] adds them.
     #[must_use]
     pub fn of(values: &[f64]) -> Option<GridSummary> {
         if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
@@ -141,7 +144,23 @@ impl GridSummary {
         let e_min = values.iter().copied().fold(f64::INFINITY, f64::min);
         let e_max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
-        Some(GridSummary { points: values.len(), e_avg, e_min, e_max, u0: ratio(e_min, e_avg), min_over_max: ratio(e_min, e_max) })
+        Some(GridSummary {
+            points: values.len(),
+            e_avg,
+            e_min,
+            e_max,
+            u0: ratio(e_min, e_avg),
+            min_over_max: ratio(e_min, e_max),
+            e_err_max: None,
+        })
+    }
+
+    /// The same figures with the largest of the points' estimated errors `errors` (same unit);
+    /// none when one is not finite (the solve had no estimate).
+    #[must_use]
+    pub fn with_errors(mut self, errors: &[f64]) -> GridSummary {
+        self.e_err_max = errors.iter().all(|e| e.is_finite()).then(|| errors.iter().copied().fold(0.0, f64::max));
+        self
     }
 }
 

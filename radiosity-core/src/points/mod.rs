@@ -58,6 +58,9 @@ impl CalcPoint {
 pub struct PointIrradiance {
     /// Irradiance per channel on the receiver's side (W/m²).
     pub h: [f64; 3],
+    /// The estimated error of `h` per channel, W/m² (see [`PointGather`]'s contract); NaN where
+    /// the solve has no error estimate to start from.
+    pub h_err: [f64; 3],
     /// Visibility rays cast for this point (0 where none were needed).
     pub rays: u64,
 }
@@ -67,5 +70,12 @@ impl PointIrradiance {
     #[must_use]
     pub fn photopic(&self) -> f64 {
         photopic(self.h)
+    }
+
+    /// The estimated error of [`PointIrradiance::photopic`] (the photopic value of the channels'
+    /// errors: its weights are positive).
+    #[must_use]
+    pub fn photopic_err(&self) -> f64 {
+        photopic(self.h_err)
     }
 }

@@ -98,7 +98,9 @@ fn grid_specs_read_from_toml_deny_unknown_fields() {
 #[test]
 fn summary_of_known_values() {
     let s = GridSummary::of(&[100.0, 200.0, 300.0, 400.0]).unwrap();
-    assert_eq!(s, GridSummary { points: 4, e_avg: 250.0, e_min: 100.0, e_max: 400.0, u0: 0.4, min_over_max: 0.25 });
+    assert_eq!(s, GridSummary { points: 4, e_avg: 250.0, e_min: 100.0, e_max: 400.0, u0: 0.4, min_over_max: 0.25, e_err_max: None });
+    assert_eq!(s.with_errors(&[1.0, 3.0, 2.0, 0.5]).e_err_max, Some(3.0));
+    assert_eq!(s.with_errors(&[1.0, f64::NAN]).e_err_max, None);
     let dark = GridSummary::of(&[0.0, 0.0]).unwrap();
     assert_eq!((dark.u0, dark.min_over_max), (0.0, 0.0));
     assert_eq!(GridSummary::of(&[]), None);
