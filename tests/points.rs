@@ -287,6 +287,18 @@ fn cie_5_7_obstruction_shadows_within_one_percent() {
         1e3 * seconds,
         solved.hierarchy.leaves().count()
     );
+    // Each lit point's estimated error covers its error (up to the reference's rounding).
+    let with_errors = points::gather(&solved, &pts, &PointsConfig::default());
+    for ((p, &e), r) in pts.iter().zip(&exact).zip(&with_errors).take(lit) {
+        eprintln!("  {}: error {:.4} estimated {:.4}", p.name, r.h[0] - e, r.h_err[0]);
+        assert!(
+            (r.h[0] - e).abs() <= r.h_err[0] + REFERENCE_ROUNDING,
+            "{}: {} against {e}, estimated error {}",
+            p.name,
+            r.h[0],
+            r.h_err[0]
+        );
+    }
 }
 
 /// Lambert's closed form for a point on the normal through a corner of a parallel `a × b`
