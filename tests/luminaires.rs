@@ -128,6 +128,29 @@ fn cie171_5_2_point_source_values() {
     }
     // The table's own value at the published points (CIE: 111.111 lx at A, 49.383 at J).
     assert!((got[0].photopic() - 111.111).abs() < 0.01 && (got[9].photopic() - 49.383).abs() < 0.05);
+
+    // The same points as a grid (offsets 0 to 1.5 m every 0.5 m, 16 points: the published ten
+    // and their mirror images), each with its estimated error: the black plane reflects nothing,
+    // and a luminaire's light at a point is exact for its table, so the estimate is 0 and the
+    // error is the table's interpolation of the cosine (within 1e-3).
+    let spec = radiosity::points::GridSpec {
+        name: "cie52".into(),
+        origin: [-0.25, -0.25, 0.0],
+        u: [2.0, 0.0, 0.0],
+        v: [0.0, 2.0, 0.0],
+        spacing: 0.5,
+        normal: None,
+    };
+    let grid = spec.grid().unwrap();
+    assert_eq!(grid.points.len(), 16);
+    let got = radiosity::points::gather(&solved, &grid.points, &PointsConfig::default());
+    for (p, r) in grid.points.iter().zip(&got) {
+        let d2 = p.position.x * p.position.x + p.position.y * p.position.y + 9.0;
+        let exact = 1000.0 * 9.0 / (d2 * d2);
+        let (e, err) = (r.photopic(), r.photopic_err());
+        assert!((e / exact - 1.0).abs() <= 1e-3, "{}: {e} lx against {exact}", p.name);
+        assert!(err.is_finite() && (e - exact).abs() <= err + 1e-3 * exact, "{}: {e} against {exact}, estimated error {err}", p.name);
+    }
 }
 
 /// A box between a downlight and the floor of a black room: the floor under it gets no direct
