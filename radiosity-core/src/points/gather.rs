@@ -129,14 +129,6 @@ fn kernel_variation(x: DVec3, n: DVec3, s: &Source) -> f64 {
     if hi > 0.0 { ((hi - lo) / (hi + lo)).min(1.0) } else { 1.0 }
 }
 
-/// The largest mean radiosity over the non-emitting polygons (every polygon when all emit): what
-/// the solve's error estimate is relative to.
-fn largest_non_emitting_mean(h: &Hierarchy, radiosity: &[[f64; 3]]) -> f64 {
-    let emits = |p: usize| h.emission[p].iter().any(|&e| e > 0.0);
-    let all = (0..h.n_polygons as usize).all(emits);
-    (0..h.n_polygons as usize).filter(|&p| all || !emits(p)).flat_map(|p| radiosity[p]).fold(0.0, f64::max)
-}
-
 /// The leaves of a solution that give light, prepared for gathering at many points.
 ///
 /// Contract of [`PointGather::irradiance`]: `H(x) = Σ B_leaf · F(dx → leaf) · V(x, leaf)` over the
@@ -231,8 +223,9 @@ impl<'a> PointGather<'a> {
         for s in &mut g.sources {
             s.variation = variation[s.id as usize];
         }
-        g.mean_error =
-            solved.error_estimate.map_or(f64::NAN, |e| e * largest_non_emitting_mean(&solved.hierarchy, &solved.solution.radiosity));
+        g.mean_error = solved
+            .error_estimate
+            .map_or(f64::NAN, |e| e * crate::solve::largest_non_emitting_mean(&solved.hierarchy, &solved.solution.radiosity));
         g
     }
 

@@ -219,16 +219,24 @@ fn receiver_polygons(h: &crate::hierarchy::Hierarchy, receiver: crate::hierarchy
 /// The largest `error(polygon, channel)` over the non-emitting polygons (every polygon in a
 /// furnace, where all emit), relative to the largest non-emitting polygon mean of `radiosity`.
 fn worst_relative(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], error: impl Fn(usize, usize) -> f64) -> f64 {
-    let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
-    let all = emitting.iter().all(|&e| e);
-    let (mut top, mut worst) = (0.0f64, 0.0f64);
-    for p in (0..h.n_polygons as usize).filter(|&p| all || !emitting[p]) {
-        for c in 0..3 {
-            top = top.max(radiosity[p][c]);
-            worst = worst.max(error(p, c));
-        }
-    }
+    let top = largest_non_emitting_mean(h, radiosity);
+    let worst = measured_polygons(h).flat_map(|p| (0..3).map(move |c| (p, c))).map(|(p, c)| error(p, c)).fold(0.0, f64::max);
     if top > 0.0 { worst / top } else { 0.0 }
+}
+
+/// The polygons the estimate measures: the non-emitting ones (every polygon in a furnace, where
+/// all emit).
+fn measured_polygons(h: &crate::hierarchy::Hierarchy) -> impl Iterator<Item = usize> + '_ {
+    let emits = |p: usize| h.emission[p].iter().any(|&x| x > 0.0);
+    let all = (0..h.n_polygons as usize).all(emits);
+    (0..h.n_polygons as usize).filter(move |&p| all || !emits(p))
+}
+
+/// The largest mean (every channel) of `radiosity` (per polygon, or per element with the polygons
+/// first) over the polygons the estimate measures: what the error estimate is relative to.
+#[must_use]
+pub fn largest_non_emitting_mean(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]]) -> f64 {
+    measured_polygons(h).flat_map(|p| radiosity[p]).fold(0.0, f64::max)
 }
 
 /// The error that polygons left whole put into the others' means, relative to the largest
