@@ -372,6 +372,21 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         stats.grids = Some(write_grids(&args.out, &grids, &grid_results, scene.units)?);
         stats.time_s.grids = Some(grid_seconds);
     }
+    // The target holds for the points and grids too, or the answer says it does not.
+    let sets = gathered.iter().map(|(_, r, _)| ("the calculation points".to_owned(), r.as_slice()));
+    let sets = sets.chain(grids.iter().zip(&grid_results).map(|(g, r)| (format!("grid `{}`", g.spec.name), r.as_slice())));
+    for (what, results) in sets {
+        if let (Some(target), Some(worst)) = (config.target_error, radiosity::points::worst_relative_error(results))
+            && worst > target
+        {
+            stats.solve_warnings.push(format!(
+                "{what}: estimated error up to {:.3}% of the largest value, above the target {:.3}%: the target steers the \
+                 refinement of surface means, not yet of points; a smaller --target-error brings it down (see h_err)",
+                100.0 * worst,
+                100.0 * target
+            ));
+        }
+    }
     stats.time_s.output = t_out.elapsed().as_secs_f64();
     stats.time_s.total = t0.elapsed().as_secs_f64();
     stats.time_s.runs = runs;

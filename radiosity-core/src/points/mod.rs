@@ -79,3 +79,31 @@ impl PointIrradiance {
         photopic(self.h_err)
     }
 }
+
+/// The largest estimated error of the photopic values of `results`, relative to the largest of
+/// them (as the solve's estimate is relative to the largest polygon mean); `None` when there is
+/// no light or an error is not known.
+#[must_use]
+pub fn worst_relative_error(results: &[PointIrradiance]) -> Option<f64> {
+    let top = results.iter().map(PointIrradiance::photopic).fold(0.0, f64::max);
+    let worst = results.iter().map(PointIrradiance::photopic_err).try_fold(0.0f64, |w, e| e.is_finite().then_some(w.max(e)))?;
+    (top > 0.0).then_some(worst / top)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(h: f64, err: f64) -> PointIrradiance {
+        PointIrradiance { h: [h; 3], h_err: [err; 3], rays: 0 }
+    }
+
+    /// The worst error relative to the largest value (grey channels: photopic = each channel).
+    #[test]
+    fn worst_relative_error_is_relative_to_the_largest_value() {
+        let worst = worst_relative_error(&[point(100.0, 0.5), point(10.0, 2.0), point(50.0, 1.0)]).unwrap();
+        assert!((worst - 0.02).abs() < 1e-12, "{worst}");
+        assert_eq!(worst_relative_error(&[point(100.0, 0.5), point(10.0, f64::NAN)]), None, "an unknown error");
+        assert_eq!(worst_relative_error(&[point(0.0, 0.0)]), None, "no light");
+    }
+}
