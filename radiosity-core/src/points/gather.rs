@@ -144,7 +144,7 @@ fn kernel_variation(x: DVec3, n: DVec3, s: &Source) -> f64 {
 ///
 /// The estimated error `h_err` of each point adds, over the leaves it sees: half the range of the
 /// leaf's radiosity (probed over it, [`crate::solve::element_data`]) times `F·V` times how much
-/// the kernel varies over the leaf ([`kernel_variation`]: a far leaf's mean is all a point sees
+/// the kernel varies over the leaf (`kernel_variation`: a far leaf's mean is all a point sees
 /// of it, a near one's shape shows); the solve's error estimate of a mean, as W/m², times `F·V`;
 /// and [`SHADOW_EDGE_REL_ERROR`] times `F·B` for a leaf seen in part. Measured on the 1990 test
 /// room's 480 points (`tests/accuracy.rs`): at the default target every point's true error is

@@ -568,7 +568,7 @@ impl LeafCoefficients {
     }
 
     /// Per link (in the order of the links given), the factor the closure applied to the light
-    /// it carries, less 1, where that is a correction of sampling ([`CLOSURE_NOISE_MAX`]; 0 where
+    /// it carries, less 1, where that is a correction of sampling (`CLOSURE_NOISE_MAX`, 2%; 0 where
     /// it makes up for a cover); empty in an open scene. See [`super::closure_error`].
     #[must_use]
     pub fn closure_changes(&self) -> &[f32] {
