@@ -15,16 +15,16 @@ const WARD_CLASS_TOL: f64 = 0.01;
 const CIE58_MEAN_TOL: f64 = 0.005;
 /// Tolerance of the power balance of a closed scene (the bar).
 const BALANCE_TOL: f64 = 0.005;
-/// Tolerance of Ward's calculation points at the default settings.
-const WARD_POINT_TOL: f64 = 0.03;
+/// Tolerance of Ward's calculation points at the default settings (the bar).
+const WARD_POINT_TOL: f64 = 0.01;
 /// The reference points' own uncertainty (constant elements with exact form factors on three
 /// meshes, Richardson-extrapolated: within 0.2%, as shipped with them).
 const WARD_POINT_REFERENCE_TOL: f64 = 0.002;
 /// Share of the points whose true error is within their estimated error (plus the reference's
-/// own): the bar; measured 480 of 480 at the default target and at 0.003.
+/// own): the bar; measured 480 of 480 with and without importance rounds.
 const POINT_ESTIMATE_COVER: f64 = 0.95;
-/// The worst point's estimate, at most this times its true error (measured 1.9 at the default
-/// target, 1.0 at 0.003).
+/// The worst point's estimate, at most this times its true error (measured 2.2 with the
+/// importance rounds of the default settings).
 const POINT_ESTIMATE_MAX_RATIO: f64 = 3.0;
 /// The default target error of `radiosity solve`.
 const DEFAULT_TARGET: f64 = 0.01;
@@ -230,18 +230,19 @@ fn memory_budget_stops_refinement_with_a_warning() {
 }
 
 /// Ward's room's 480 calculation points (`reference_points.csv`, radiosity `ρ H` on the floor and
-/// ceiling), gathered from the default solve: within [`WARD_POINT_TOL`] at every point. A point
-/// gathers the leaves' radiosity, constant over each leaf, and a point 0.25 m from two walls sees
-/// their leaves at the corner most; at the default target (1% on polygon means) the worst point is
-/// 2.6% off (room corners), at a target of 0.3% 0.6%, at 0.1% 0.26% (measured 2026-12-01). Each
-/// point's estimated error (`points.csv` `h_err`) covers its true error, and the worst point's is
-/// 1.9 times its error (4.8% for 2.6%).
+/// ceiling), solved as `radiosity solve --points` solves them at the default settings: once the
+/// polygon means meet the target, importance rounds refine where the points' estimated errors come
+/// from (`pipeline::run_with_points`), until each point's, relative to its own value, is within
+/// the target. Every point within [`WARD_POINT_TOL`] of the reference; each point's estimated
+/// error (`h_err`) covers its true error, and the worst point's is at most
+/// [`POINT_ESTIMATE_MAX_RATIO`] times it. Measured 2026-12-05: worst 0.31% (ceiling corner),
+/// estimated 0.69% there, 480 of 480 covered, 3 rounds, 14 s; without the rounds the worst point
+/// was 2.6% off (room corners: a point 0.25 m from two walls sees their leaves at the corner most).
 #[test]
-fn ward_room_points_within_two_percent_at_the_default_settings() {
+fn ward_room_points_within_one_percent_at_the_default_settings() {
     use radiosity::geom::DVec3;
-    use radiosity::points::{CalcPoint, PointsConfig, gather};
+    use radiosity::points::CalcPoint;
     let c = case("ward-room");
-    let solved = solve_default(&c.scene);
     let reference = validation::ward_room_points();
     assert_eq!(reference.len(), 480);
     let points: Vec<CalcPoint> = reference
@@ -251,21 +252,26 @@ fn ward_room_points_within_two_percent_at_the_default_settings() {
             CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
         })
         .collect();
-    let got = gather(&solved, &points, &PointsConfig::default());
+    let config = Config { target_error: Some(DEFAULT_TARGET), ..Config::default() };
+    let solved = pipeline::run_with_points(&c.scene, &BfHand::default(), &config, &[&points], &|_| {});
+    let report = solved.importance.expect("the points asked for importance rounds");
+    assert!(report.met && report.rounds > 0, "{report:?}");
+    let got = &solved.point_results[0];
     let (mut worst, mut worst_estimate, mut covered): (f64, f64, usize) = (0.0, 0.0, 0);
-    for ((surface, x, y, b_ref), h) in reference.iter().zip(&got) {
+    for ((surface, x, y, b_ref), h) in reference.iter().zip(got) {
         let rho = if surface == "floor" { 0.3 } else { 0.7 };
         let err = rho * h.h[0] / b_ref - 1.0;
         assert!(err.abs() <= WARD_POINT_TOL, "{surface} ({x}, {y}): {:+.2}%", 100.0 * err);
         // The point's own estimated error, relative to its value as `err` is.
         let estimate = rho * h.h_err[0] / b_ref;
+        assert!(estimate <= DEFAULT_TARGET + WARD_POINT_REFERENCE_TOL, "{surface} ({x}, {y}): estimate {estimate}");
         covered += usize::from(estimate + WARD_POINT_REFERENCE_TOL >= err.abs());
         if err.abs() > worst {
             (worst, worst_estimate) = (err.abs(), estimate);
         }
     }
     eprintln!(
-        "Ward's 480 points: worst {:.2}%, estimated {:.2}% there; {covered} points within their estimate",
+        "Ward's 480 points: worst {:.2}%, estimated {:.2}% there; {covered} points within their estimate; {report:?}",
         100.0 * worst,
         100.0 * worst_estimate
     );
@@ -274,6 +280,34 @@ fn ward_room_points_within_two_percent_at_the_default_settings() {
         worst_estimate >= worst - WARD_POINT_REFERENCE_TOL && worst_estimate <= POINT_ESTIMATE_MAX_RATIO * worst,
         "the worst point's estimate {worst_estimate} against its error {worst}"
     );
+}
+
+/// Without importance (`pipeline::run`, points gathered after the solve), each point's estimated
+/// error still covers its true error: measured 480 of 480, the worst point 2.6% off (a room
+/// corner) for an estimate of 4.8% there.
+#[test]
+fn ward_room_point_estimates_cover_their_errors_without_importance() {
+    use radiosity::geom::DVec3;
+    use radiosity::points::{CalcPoint, PointsConfig, gather};
+    let c = case("ward-room");
+    let solved = solve_default(&c.scene);
+    assert!(solved.importance.is_none() && solved.point_results.is_empty());
+    let reference = validation::ward_room_points();
+    let points: Vec<CalcPoint> = reference
+        .iter()
+        .map(|(surface, x, y, _)| {
+            let (z, n) = if surface == "floor" { (0.0, DVec3::Z) } else { (3.0, -DVec3::Z) };
+            CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
+        })
+        .collect();
+    let got = gather(&solved, &points, &PointsConfig::default());
+    let mut covered = 0;
+    for ((surface, _, _, b_ref), h) in reference.iter().zip(&got) {
+        let rho = if surface == "floor" { 0.3 } else { 0.7 };
+        let err = (rho * h.h[0] / b_ref - 1.0).abs();
+        covered += usize::from(rho * h.h_err[0] / b_ref + WARD_POINT_REFERENCE_TOL >= err);
+    }
+    assert!(covered as f64 >= POINT_ESTIMATE_COVER * 480.0, "{covered} of 480 points within their estimated error");
 }
 
 /// The target steers the work: Ward's room at a target of 0.1 stops at a coarser level than at
@@ -334,4 +368,54 @@ fn partitions_standing_on_the_floor_do_not_stall_the_estimate() {
     eprintln!("obstructed room: {} links, estimate {:.2}%", solved.links.len(), 100.0 * estimate);
     assert!(solved.target_missed.is_none() && estimate <= DEFAULT_TARGET, "estimate {estimate}: {:?}", solved.target_missed);
     assert!(solved.links.len() <= 1_000_000, "{} links", solved.links.len());
+}
+
+/// Importance goes where the points are: Ward's room with only the reference points of one
+/// corner (x, y ≤ 1.25 m, floor and ceiling) multiplies the leaves near that corner's edge (within
+/// 2.5 m) at least twice as much as those far from it (beyond 6 m), and those points are each
+/// within [`WARD_POINT_TOL`] of the reference, within their estimates. Measured 2026-12-05: 98 ->
+/// 1,132 leaves near, 494 -> 2,269 far (the corner's links are tightened up to the polygons they
+/// start from, and the oracle splits their far sources too), 3 rounds, 4.3 s, the 18 points within
+/// 0.27%.
+#[test]
+fn importance_refines_near_the_points_only() {
+    use radiosity::geom::DVec3;
+    use radiosity::points::CalcPoint;
+    let c = case("ward-room");
+    let corner: Vec<(String, f64, f64, f64)> =
+        validation::ward_room_points().into_iter().filter(|(_, x, y, _)| *x <= 1.25 && *y <= 1.25).collect();
+    assert_eq!(corner.len(), 18);
+    let points: Vec<CalcPoint> = corner
+        .iter()
+        .map(|(surface, x, y, _)| {
+            let (z, n) = if surface == "floor" { (0.0, DVec3::Z) } else { (3.0, -DVec3::Z) };
+            CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
+        })
+        .collect();
+    let config = Config { target_error: Some(DEFAULT_TARGET), ..Config::default() };
+    let with = pipeline::run_with_points(&c.scene, &BfHand::default(), &config, &[&points], &|_| {});
+    let without = solve_default(&c.scene);
+    let report = with.importance.expect("importance rounds");
+    assert!(report.met && report.rounds > 0 && report.leaves_split > 0, "{report:?}");
+    for ((surface, x, y, b_ref), h) in corner.iter().zip(&with.point_results[0]) {
+        let rho = if surface == "floor" { 0.3 } else { 0.7 };
+        let err = (rho * h.h[0] / b_ref - 1.0).abs();
+        let estimate = rho * h.h_err[0] / b_ref;
+        assert!(err <= WARD_POINT_TOL, "{surface} ({x}, {y}): {:.2}%", 100.0 * err);
+        assert!(err <= estimate + WARD_POINT_REFERENCE_TOL, "{surface} ({x}, {y}): {err} for an estimate of {estimate}");
+    }
+    // Leaves of every surface near the corner's vertical edge and far from it.
+    let count = |s: &Solved, near: bool| {
+        let h = &s.hierarchy;
+        h.leaves()
+            .map(|l| h.get(l).center)
+            .filter(|c| {
+                let d = (c.x * c.x + c.y * c.y).sqrt();
+                if near { d < 2.5 } else { d > 6.0 }
+            })
+            .count() as f64
+    };
+    let (near, far) = ((count(&without, true), count(&with, true)), (count(&without, false), count(&with, false)));
+    eprintln!("corner leaves {} -> {}, far {} -> {}; {report:?}", near.0, near.1, far.0, far.1);
+    assert!(near.1 / near.0 >= 2.0 * (far.1 / far.0), "the corner's leaves {} -> {}, the far ones' {} -> {}", near.0, near.1, far.0, far.1);
 }

@@ -10,6 +10,9 @@ use crate::visibility::{RayCaster, VisibilityConfig};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+mod importance;
+pub use importance::{IMPORTANCE_AIM, IMPORTANCE_MAX_ROUNDS, ImportanceReport};
+
 /// Settings of a full solve.
 #[derive(Clone, Copy, Debug)]
 pub struct Config {
@@ -174,6 +177,9 @@ pub struct Timings {
     /// The error estimate (the solves on coarsened meshes, the visibility noise) and, with
     /// daylight, the power balance measured per level.
     pub estimate: f64,
+    /// The importance rounds for calculation points and grids (their gathers, subdivisions and
+    /// solves; see [`run_with_points`]).
+    pub importance: f64,
 }
 
 /// Progress events for front ends.
@@ -239,6 +245,11 @@ pub struct LevelReport {
     /// ([`crate::daylight::balance_gap`]); absent without.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub balance_gap: Option<f64>,
+    /// With point sets, once the polygon means met the target: the worst estimated error of a
+    /// point read after this level, relative to its value (see [`run_with_points`]); absent
+    /// otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points_error: Option<f64>,
 }
 
 /// With daylight and a target error, the levels also run on until the power balance closes within
@@ -380,6 +391,18 @@ pub struct Solved {
     pub lights: crate::light::Lights,
     /// Final links.
     pub links: Vec<Link>,
+    /// What the importance rounds for point sets did ([`run_with_points`]); `None` when there
+    /// were none (no point set, no target, or the target not met by the levels).
+    pub importance: Option<ImportanceReport>,
+    /// The point sets' results as the last importance round read them from this solution (their
+    /// `h_err` counts what they moved over the last round as well), one per set given to
+    /// [`run_with_points`]; empty when no round ran.
+    pub point_results: Vec<Vec<crate::points::PointIrradiance>>,
+    /// Per polygon, the estimated error of its mean radiosity, W/m² (largest channel): its own
+    /// Richardson estimate with the scene-wide terms of [`Solved::error_estimate`] (whose largest,
+    /// over the largest mean, it is); empty when not estimated. What a calculation point's
+    /// estimate counts for the leaves it sees.
+    pub polygon_errors: Vec<f64>,
     /// Final solution.
     pub solution: Solution,
     /// Ray caster (for rendering), when visibility was used or requested.
@@ -436,6 +459,21 @@ pub struct Solved {
 /// [`Config::target_error`]), each a few refine → solve rounds ending with the leaf-resolution
 /// solve.
 pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn Fn(Progress)) -> Solved {
+    run_with_points(scene, oracle, config, &[], progress)
+}
+
+/// [`run`], with point sets the target error applies to as well (calculation points, each grid):
+/// once the levels meet the target on the polygon means, the leaves that the points' estimated
+/// errors come from are subdivided until every set's worst estimated error, relative to its
+/// largest value, is within the target too ([`importance`](ImportanceReport)). Without a target
+/// error, or with no sets, the same as [`run`].
+pub fn run_with_points(
+    scene: &Scene,
+    oracle: &dyn Oracle,
+    config: &Config,
+    point_sets: &[&[crate::points::CalcPoint]],
+    progress: &dyn Fn(Progress),
+) -> Solved {
     let t0 = Instant::now();
     let traits = config.analyse.then(|| SceneTraits::of(scene));
     let left_out = traits.as_ref().map(SceneTraits::left_out).unwrap_or_default();
@@ -492,8 +530,17 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
     // Without a target the last level is at the oracle's eps; with one, the levels run on from the
     // same first level until the estimate is below the target.
     let first_scale = config.level_step.powi(config.levels.max(1) as i32 - 1);
-    for level in 0..n_levels {
-        let scale = first_scale / config.level_step.powi(level as i32);
+    // Point sets: once the polygon means meet the target, rounds at the last level's scale
+    // refine where the points need it (see `importance`), each a level of its own.
+    let has_points = target_error.is_some() && point_sets.iter().any(|s| !s.is_empty());
+    let points_config = crate::points::PointsConfig { use_visibility: config.use_visibility, ..Default::default() };
+    let mut importance: Option<ImportanceReport> = None;
+    let mut point_results: Vec<Vec<crate::points::PointIrradiance>> = Vec::new();
+    let mut polygon_errors: Vec<f64> = Vec::new();
+    let mut rounds = 0;
+    let max_rounds = if has_points { IMPORTANCE_MAX_ROUNDS } else { 0 };
+    for level in 0..n_levels + max_rounds {
+        let scale = first_scale / config.level_step.powi((level - rounds) as i32);
         let limits = refine::RefineLimits { max_bytes: config.max_memory_bytes };
         let mut level_solution = None;
         for pass in 1..=config.max_passes.max(1) {
@@ -575,21 +622,24 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         iterations += more_iterations;
         timings.solve += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        if level + 1 < n_levels {
+        if level + 1 < n_levels || has_points {
             update_data(&mut data, &h, &links, &sol, config);
         }
         timings.refine += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let means: Vec<[f64; 3]> = crate::output::polygon_results(&h, &sol).into_iter().map(|r| r.b).collect();
         let change = history.push(means);
-        let last = level + 1 == n_levels || stats.refused_for_memory > 0;
-        let estimate = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
+        let last = level - rounds + 1 == n_levels || stats.refused_for_memory > 0;
+        let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
+        let estimate = estimated.as_ref().map(|e| e.0);
+        polygon_errors = estimated.map(|e| e.1).unwrap_or_default();
         let balance_gap = (!lights.distant.is_empty() && target_error.is_some())
             .then(|| crate::daylight::balance_gap(&h, &lights.distant, &sol, &caster));
         timings.estimate += t.elapsed().as_secs_f64();
         let report = LevelReport {
             balance_gap,
+            points_error: None,
             threshold_scale: scale,
             elements: h.len(),
             leaves: h.leaves().count(),
@@ -611,7 +661,54 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         let estimate = estimate.unwrap_or(f64::INFINITY);
         let gap_closed = balance_gap.is_none_or(|g| g <= BALANCE_SHARE_OF_TARGET * target);
         if estimate <= target && gap_closed {
-            break;
+            if !has_points || stats.refused_for_memory > 0 {
+                break;
+            }
+            let t = Instant::now();
+            let sol = solution.as_ref().expect("solved above");
+            let parts = crate::points::SolveParts {
+                hierarchy: &h,
+                links: &links,
+                solution: sol,
+                lights: &lights,
+                caster: &caster,
+                convex_enclosure: traits.as_ref().is_some_and(|t| !t.needs_visibility),
+                error_estimate: Some(estimate),
+                polygon_errors: Some(&polygon_errors),
+                variation: (config.measure_variation && data.variation.len() == h.len()).then_some(data.variation.as_slice()),
+            };
+            let round = importance::round(&parts, point_sets, target, &points_config, (rounds > 0).then_some(point_results.as_slice()));
+            if let Some(l) = levels.last_mut() {
+                l.points_error = Some(round.worst);
+            }
+            let report = importance.get_or_insert(ImportanceReport { worst_before: round.worst, ..ImportanceReport::default() });
+            (report.worst_after, report.met) = (round.worst, round.worst <= target);
+            point_results = round.results;
+            let bytes = h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK;
+            let mut made = 0;
+            if !report.met && rounds < max_rounds && bytes <= config.max_memory_bytes {
+                for &leaf in &round.split {
+                    if h.get(leaf).n_children == 0 && h.subdivide(leaf) {
+                        data.inherit(&h, leaf);
+                        made += 1;
+                    }
+                }
+                for &leaf in &round.tighten {
+                    data.tighten(&h, leaf, importance::IMPORTANCE_TIGHTEN);
+                }
+                for e in h.match_sides() {
+                    data.inherit(&h, e);
+                }
+                crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
+            }
+            timings.importance += t.elapsed().as_secs_f64();
+            if (made == 0 && round.tighten.is_empty()) || report.met || rounds == max_rounds || bytes > config.max_memory_bytes {
+                break;
+            }
+            report.rounds += 1;
+            report.leaves_split += made;
+            rounds += 1;
+            continue;
         }
         let stop = if stats.refused_for_memory > 0 {
             Some(StopCause::MemoryBudget)
@@ -626,7 +723,7 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         } else {
             None
         };
-        let stop = stop.or((level + 1 == n_levels).then_some(StopCause::MaxLevels));
+        let stop = stop.or((level - rounds + 1 == n_levels).then_some(StopCause::MaxLevels));
         if let Some(cause) = stop {
             target_missed = Some(TargetMissed {
                 target,
@@ -673,6 +770,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
         hierarchy: h,
         lights,
         links,
+        importance,
+        point_results,
+        polygon_errors,
         solution,
         caster,
         memory_limited: stats.refused_for_memory > 0,
@@ -704,7 +804,9 @@ pub fn run(scene: &Scene, oracle: &dyn Oracle, config: &Config, progress: &dyn F
 /// only the radiosity when [`Config::measure_variation`] is off.
 fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solution, config: &Config) {
     if config.measure_variation {
+        let importance = std::mem::take(&mut data.importance);
         *data = solve::element_data(h, links, sol);
+        data.importance = importance;
     } else {
         data.radiosity.clone_from(&sol.radiosity);
     }
@@ -725,7 +827,7 @@ fn estimate_error(
     closure_changes: &[f32],
     config: &Config,
     max_bytes: usize,
-) -> f64 {
+) -> (f64, Vec<f64>) {
     let emitting: Vec<bool> = h.emission.iter().map(|e| e.iter().any(|&x| x > 0.0)).collect();
     // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
     let irradiance = config.criterion == refine::Criterion::Irradiance;
@@ -748,15 +850,24 @@ fn estimate_error(
         means.push(results.iter().map(|r| r.b).collect());
         h_means.push(with_direct(results));
     }
-    let mut mesh =
-        solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + solve::unresolved_polygons(h, links, &sol.radiosity);
+    let mesh_unresolved = solve::unresolved_polygons(h, links, &sol.radiosity);
+    let mut mesh = solve::richardson_estimate(&emitting, &means[0], &means[1], &means[2]) + mesh_unresolved;
     if irradiance {
         mesh = mesh.max(solve::richardson_estimate(&emitting, &h_means[0], &h_means[1], &h_means[2]));
     }
     let kept_rays = config.criterion.kept_rays(config.visibility.rays);
     let noise = solve::visibility_noise(h, links, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()), kept_rays);
     let closure = solve::closure_error(h, links, closure_changes, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()));
-    solve::ESTIMATE_SAFETY * mesh.max(noise).max(closure) + solve::ESTIMATE_FLOOR
+    let estimate = solve::ESTIMATE_SAFETY * mesh.max(noise).max(closure) + solve::ESTIMATE_FLOOR;
+    // Per polygon, in W/m² of radiosity: its own mesh error, the scene-wide terms as they are.
+    let top = solve::largest_non_emitting_mean(h, &sol.radiosity);
+    let unresolved = mesh_unresolved * top;
+    let wide = noise.max(closure) * top;
+    let per_polygon = solve::richardson_per_polygon(&means[0], &means[1], &means[2])
+        .into_iter()
+        .map(|e| solve::ESTIMATE_SAFETY * (e + unresolved).max(wide) + solve::ESTIMATE_FLOOR * top)
+        .collect();
+    (estimate, per_polygon)
 }
 
 /// Each polygon's mean direct irradiance from the luminaires and distant sources

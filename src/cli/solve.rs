@@ -242,17 +242,20 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
     // The method the solve will use (an oracle that needs shafts gets them), as stats.json reports it.
     let mut config = args.options.config();
     config.visibility_method = pipeline::effective_visibility(oracle.as_ref(), config.visibility_method);
-    let mut solved = pipeline::run(&scene, oracle.as_ref(), &config, &|p| reporter.event(p));
+    // The target applies to the calculation points and every grid as well (importance rounds).
+    let point_sets: Vec<&[radiosity::points::CalcPoint]> =
+        points.iter().map(Vec::as_slice).chain(grids.iter().map(|g| g.points.as_slice())).collect();
+    let mut solved = pipeline::run_with_points(&scene, oracle.as_ref(), &config, &point_sets, &|p| reporter.event(p));
     let mut runs = 1;
     let mut repeats = None;
     if args.time_for > 0.0 {
         reporter.phase("timing further solves");
         let t_runs = Instant::now();
         while runs < MAX_TIMED_RUNS && t_runs.elapsed().as_secs_f64() < args.time_for {
-            let t = pipeline::run(&scene, oracle.as_ref(), &config, &|_| {}).timings;
+            let t = pipeline::run_with_points(&scene, oracle.as_ref(), &config, &point_sets, &|_| {}).timings;
             let best = &mut solved.timings;
             (best.build, best.refine, best.solve) = (best.build.min(t.build), best.refine.min(t.refine), best.solve.min(t.solve));
-            best.estimate = best.estimate.min(t.estimate);
+            (best.estimate, best.importance) = (best.estimate.min(t.estimate), best.importance.min(t.importance));
             runs += 1;
         }
         repeats = Some(t_runs.elapsed().as_secs_f64());
@@ -285,11 +288,14 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             }
         }
     }
+    // The importance rounds read every set from the final solution already (their errors count
+    // what the last round moved); without them, each set is gathered now.
+    let mut read = std::mem::take(&mut solved.point_results).into_iter();
     let gathered = points.as_ref().map(|points| {
         reporter.phase(&format!("gathering at {} calculation points", points.len()));
         let t = Instant::now();
         let config = radiosity::points::PointsConfig { use_visibility: config.use_visibility, ..Default::default() };
-        let results = radiosity::points::gather(&solved, points, &config);
+        let results = read.next().unwrap_or_else(|| radiosity::points::gather(&solved, points, &config));
         (points, results, t.elapsed().as_secs_f64())
     });
     let t_grids = Instant::now();
@@ -298,7 +304,7 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         .map(|g| {
             reporter.phase(&format!("gathering at grid `{}` ({} points)", g.spec.name, g.points.len()));
             let config = radiosity::points::PointsConfig { use_visibility: config.use_visibility, ..Default::default() };
-            radiosity::points::gather(&solved, &g.points, &config)
+            read.next().unwrap_or_else(|| radiosity::points::gather(&solved, &g.points, &config))
         })
         .collect();
     let grid_seconds = t_grids.elapsed().as_secs_f64();
@@ -380,10 +386,14 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             && worst > target
         {
             stats.solve_warnings.push(format!(
-                "{what}: estimated error up to {:.3}% of the largest value, above the target {:.3}%: the target steers the \
-                 refinement of surface means, not yet of points; a smaller --target-error brings it down (see h_err)",
+                "{what}: estimated error up to {:.3}% of a point's value (or of 1% of the largest), above the target {:.3}%{}; a \
+                 smaller --target-error brings it down (see h_err)",
                 100.0 * worst,
-                100.0 * target
+                100.0 * target,
+                match solved.importance {
+                    Some(r) => format!(" after {} importance round(s)", r.rounds),
+                    None => " (the levels did not meet the target, so no importance round ran)".to_owned(),
+                }
             ));
         }
     }
@@ -451,9 +461,12 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
         let steps: Vec<String> = s
             .levels
             .iter()
-            .map(|l| match l.error_estimate {
-                Some(e) => format!("{} links {:.3}s est {:.2}%", l.links, l.time_s, 100.0 * e),
-                None => format!("{} links {:.3}s", l.links, l.time_s),
+            .map(|l| {
+                let points = l.points_error.map_or(String::new(), |p| format!(" points {:.2}%", 100.0 * p));
+                match l.error_estimate {
+                    Some(e) => format!("{} links {:.3}s est {:.2}%{points}", l.links, l.time_s, 100.0 * e),
+                    None => format!("{} links {:.3}s{points}", l.links, l.time_s),
+                }
             })
             .collect();
         println!("levels: {}", steps.join(" -> "));
@@ -504,8 +517,20 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
     for w in &s.solve_warnings {
         eprintln!("warning: {w}");
     }
+    if let Some(r) = &s.importance {
+        println!(
+            "importance: {} round(s) for the points and grids (the last levels above), {} leaves split, worst estimated error of a \
+             point {:.2}% -> {:.2}% of its value{}",
+            r.rounds,
+            r.leaves_split,
+            100.0 * r.worst_before,
+            100.0 * r.worst_after,
+            if r.met { "" } else { " (above the target)" }
+        );
+    }
     if let (Some(n), Some(seconds)) = (s.points, s.time_s.points) {
-        println!("points: irradiance at {n} calculation points in {seconds:.3}s ({} rays)", s.point_rays.unwrap_or(0));
+        let when = if s.importance.is_some() { " (read by the last importance round)".to_owned() } else { format!(" in {seconds:.3}s") };
+        println!("points: irradiance at {n} calculation points{when} ({} rays)", s.point_rays.unwrap_or(0));
     }
     let units = s.units;
     let (column, unit) = (radiosity::points::grid::photopic_column(units), radiosity::points::grid::photopic_unit(units));

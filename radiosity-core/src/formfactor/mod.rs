@@ -14,4 +14,4 @@ pub use link::{
     FAR_SEPARATION, FormFactorQuality, MAX_PROBE_PULL, NEAR_SEPARATION, ON_PLANE_REL_TOL, behind_surface, estimate, estimate_max,
     link_form_factor, point_to_element, projected_area,
 };
-pub use point_polygon::{clip_to_halfspace, point_polygon, point_polygon_unclipped};
+pub use point_polygon::{clip_to_halfspace, kernel_variation, point_polygon, point_polygon_unclipped};

@@ -72,3 +72,20 @@ pub fn clip_to_halfspace(poly: &[DVec3], x: DVec3, n: DVec3, out: &mut [DVec3; M
     }
     count
 }
+
+/// How much the transfer kernel `cos θ_x cos θ_y / r²` from point `x` (normal `n`) varies over a
+/// surface (unit `normal`, `center`, `vertices`): `(max − min) / (max + min)` over its centre and
+/// vertices, 1 where part of it is behind the point's tangent plane or faces away. The share of a
+/// non-uniform radiosity over the surface that `x` sees beyond the surface's mean (0: a far surface
+/// is seen as its mean; 1: its shape shows whole).
+#[must_use]
+pub fn kernel_variation(x: DVec3, n: DVec3, normal: DVec3, center: DVec3, vertices: &[DVec3]) -> f64 {
+    let k = |y: DVec3| {
+        let v = y - x;
+        let d2 = v.length_squared();
+        if d2 > 0.0 { n.dot(v).max(0.0) * (-normal.dot(v)).max(0.0) / (d2 * d2) } else { 0.0 }
+    };
+    let (lo, hi) =
+        std::iter::once(center).chain(vertices.iter().copied()).map(k).fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if hi > 0.0 { ((hi - lo) / (hi + lo)).min(1.0) } else { 1.0 }
+}

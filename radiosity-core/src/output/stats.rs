@@ -34,6 +34,10 @@ pub struct StatsTimes {
     /// without).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grids: Option<f64>,
+    /// The importance rounds for points and grids (gathers, subdivisions, solves; absent when
+    /// there were none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub importance: Option<f64>,
 }
 
 /// The contents of `stats.json` (keys are relied on by other tools; add, never rename).
@@ -125,6 +129,11 @@ pub struct Stats {
     /// budget that stopped them (absent when the target was reached or none was set).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub target_missed: Option<crate::pipeline::TargetMissed>,
+    /// What the importance rounds for the calculation points and grids did (absent when there
+    /// were none): rounds, leaves split, the worst estimated error of a point set before and
+    /// after (relative to the set's largest value), whether it is within the target.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub importance: Option<crate::pipeline::ImportanceReport>,
     /// The leaf-resolution operator was over its budget: coefficients computed again at every
     /// iteration instead of stored (absent when within).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -358,6 +367,7 @@ impl Stats {
                 runs: 1,
                 points: None,
                 grids: None,
+                importance: solved.importance.is_some().then_some(solved.timings.importance),
             },
             peak_rss_bytes: peak_rss_bytes(),
             left_out: solved.left_out.clone(),
@@ -376,6 +386,7 @@ impl Stats {
             memory_limited: solved.memory_limited,
             solve_warnings: solved.warnings.clone(),
             target_missed: solved.target_missed,
+            importance: solved.importance,
             leaf_over_budget: solved.leaf_over_budget,
             leaf_operator_entries: solved.leaf_entries,
             warnings: scene.warnings.clone(),

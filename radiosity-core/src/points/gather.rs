@@ -3,7 +3,7 @@
 //! in part, by adaptive regular subdivision.
 
 use super::{CalcPoint, PointIrradiance};
-use crate::formfactor::point_polygon_unclipped;
+use crate::formfactor::{kernel_variation, point_polygon_unclipped};
 use crate::geom::{Aabb, DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy, NONE};
 use crate::pipeline::Solved;
@@ -108,25 +108,51 @@ struct Source {
     b: [f64; 3],
     /// How much its radiosity varies over it (largest channel of `max − min`, W/m²; 0 unknown).
     variation: f64,
+    /// The estimated error of its mean (W/m²; NaN: the gather's `mean_error` for every leaf).
+    mean_error: f64,
+    /// How far its radiosity may be off for the sources of its links being coarse
+    /// ([`crate::solve::leaf_value_errors`], W/m²; 0 unknown).
+    value_error: f64,
     /// The leaf.
     id: ElementId,
 }
 
-/// How much the transfer kernel `cos θ_x cos θ_y / r²` from point `x` (normal `n`) varies over
-/// leaf `s`: `(max − min) / (max + min)` over its centre and vertices (1 where part of it is
-/// behind the point's tangent plane or it faces away), the share of a non-uniform radiosity
-/// over the leaf that a point sees in its irradiance beyond the leaf's mean.
-fn kernel_variation(x: DVec3, n: DVec3, s: &Source) -> f64 {
-    let k = |y: DVec3| {
-        let v = y - x;
-        let d2 = v.length_squared();
-        if d2 > 0.0 { n.dot(v).max(0.0) * (-s.normal.dot(v)).max(0.0) / (d2 * d2) } else { 0.0 }
-    };
-    let (lo, hi) = std::iter::once(s.center)
-        .chain(s.poly.vertices().iter().copied())
-        .map(k)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
-    if hi > 0.0 { ((hi - lo) / (hi + lo)).min(1.0) } else { 1.0 }
+/// One leaf's share of a point's estimated error (photopic, W/m²), by what would make it smaller.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeafError {
+    /// The leaf.
+    pub leaf: ElementId,
+    /// Subdividing the leaf: its radiosity taken as uniform over it, a shadow edge across it.
+    pub shape: f64,
+    /// Finer links to it: its value ([`crate::solve::leaf_value_errors`]).
+    pub value: f64,
+}
+
+/// What a gather at points reads of a solve, finished ([`PointGather::for_solved`]) or between
+/// its refinements (the importance rounds of [`crate::pipeline::run_with_points`]).
+#[derive(Clone, Copy)]
+pub struct SolveParts<'a> {
+    /// The hierarchy.
+    pub hierarchy: &'a Hierarchy,
+    /// Its links.
+    pub links: &'a [crate::refine::Link],
+    /// The leaf-resolution solution of the links.
+    pub solution: &'a crate::solve::Solution,
+    /// The luminaires and distant sources.
+    pub lights: &'a crate::light::Lights,
+    /// The ray caster over the scene.
+    pub caster: &'a RayCaster,
+    /// The scene is a convex enclosure (points inside it cast no ray).
+    pub convex_enclosure: bool,
+    /// The solve's error estimate (relative to its largest non-emitting polygon mean).
+    pub error_estimate: Option<f64>,
+    /// Per polygon, the estimated error of its mean radiosity (W/m²,
+    /// [`crate::pipeline::Solved::polygon_errors`]); `None` or empty: the estimate times the
+    /// largest mean for every polygon.
+    pub polygon_errors: Option<&'a [f64]>,
+    /// Each element's radiosity range for this solution ([`crate::solve::element_data`]'s
+    /// `variation`), when known already (measured again when `None`).
+    pub variation: Option<&'a [f64]>,
 }
 
 /// The leaves of a solution that give light, prepared for gathering at many points.
@@ -144,14 +170,16 @@ fn kernel_variation(x: DVec3, n: DVec3, s: &Source) -> f64 {
 ///
 /// The estimated error `h_err` of each point adds, over the leaves it sees: half the range of the
 /// leaf's radiosity (probed over it, [`crate::solve::element_data`]) times `F·V` times how much
-/// the kernel varies over the leaf (`kernel_variation`: a far leaf's mean is all a point sees
-/// of it, a near one's shape shows); the solve's error estimate of a mean, as W/m², times `F·V`;
-/// and [`SHADOW_EDGE_REL_ERROR`] times `F·B` for a leaf seen in part. Measured on the 1990 test
-/// room's 480 points (`tests/accuracy.rs`): at the default target every point's true error is
-/// within its estimate plus the reference's 0.2%, and the worst point's estimate is 1.9 times its
-/// error; at a target of 0.3%, 1.0 times. The luminaires' and distant sources' direct light
-/// (one ray each) adds none: a luminaire's is exact for the point-source model, and the sky's
-/// discretisation is not counted yet.
+/// the kernel varies over the leaf ([`crate::formfactor::kernel_variation`]: a far leaf's mean is
+/// all a point sees of it, a near one's shape shows); how far the leaf's value may be off for the
+/// sources of its links being coarse ([`crate::solve::leaf_value_errors`]) times `F·V`; the
+/// estimated error of the leaf's polygon mean (its own, [`SolveParts::polygon_errors`], or the
+/// solve's estimate times the largest mean) times `F·V`; and [`SHADOW_EDGE_REL_ERROR`] times `F·B`
+/// for a leaf seen in part. Measured on the 1990 test room's 480 points (`tests/accuracy.rs`): at
+/// the default target every point's true error is within its estimate plus the reference's 0.2%,
+/// with importance rounds (the worst point's estimate 2.2 times its error) and without. The
+/// luminaires' and distant sources' direct light (one ray each) adds none: a luminaire's is exact
+/// for the point-source model, and the sky's discretisation is not counted yet.
 pub struct PointGather<'a> {
     h: &'a Hierarchy,
     caster: Option<&'a RayCaster>,
@@ -193,6 +221,8 @@ impl<'a> PointGather<'a> {
                     polygon,
                     b,
                     variation: 0.0,
+                    value_error: 0.0,
+                    mean_error: f64::NAN,
                     id,
                 })
             })
@@ -214,24 +244,75 @@ impl<'a> PointGather<'a> {
     /// ray.
     #[must_use]
     pub fn for_solved(solved: &'a Solved, config: &PointsConfig) -> PointGather<'a> {
-        let mut g = PointGather::new(&solved.hierarchy, &solved.solution.radiosity, Some(&solved.caster), config);
-        g.convex_enclosure = solved.traits.as_ref().is_some_and(|t| !t.needs_visibility);
-        g.lights = Some(&solved.lights);
+        let solve = SolveParts {
+            hierarchy: &solved.hierarchy,
+            links: &solved.links,
+            solution: &solved.solution,
+            lights: &solved.lights,
+            caster: &solved.caster,
+            convex_enclosure: solved.traits.as_ref().is_some_and(|t| !t.needs_visibility),
+            error_estimate: solved.error_estimate,
+            polygon_errors: Some(&solved.polygon_errors),
+            variation: None,
+        };
+        PointGather::for_solve(&solve, config)
+    }
+
+    /// Prepares the gather from the parts of a solve (finished or between its refinements).
+    #[must_use]
+    pub fn for_solve(solve: &SolveParts<'a>, config: &PointsConfig) -> PointGather<'a> {
+        let mut g = PointGather::new(solve.hierarchy, &solve.solution.radiosity, Some(solve.caster), config);
+        g.convex_enclosure = solve.convex_enclosure;
+        g.lights = Some(solve.lights);
         // What the error of each point starts from: how the radiosity varies over each leaf, and
         // the estimated error of the leaves' means.
-        let variation = crate::solve::element_data(&solved.hierarchy, &solved.links, &solved.solution).variation;
+        let measured;
+        let variation = match solve.variation {
+            Some(v) => v,
+            None => {
+                measured = crate::solve::element_data(solve.hierarchy, solve.links, solve.solution).variation;
+                &measured
+            }
+        };
+        let value_errors = crate::solve::leaf_value_errors(solve.hierarchy, solve.links, &solve.solution.radiosity, variation);
         for s in &mut g.sources {
             s.variation = variation[s.id as usize];
+            s.value_error = value_errors[s.id as usize];
         }
-        g.mean_error = solved
+        g.mean_error = solve
             .error_estimate
-            .map_or(f64::NAN, |e| e * crate::solve::largest_non_emitting_mean(&solved.hierarchy, &solved.solution.radiosity));
+            .map_or(f64::NAN, |e| e * crate::solve::largest_non_emitting_mean(solve.hierarchy, &solve.solution.radiosity));
+        if let Some(per_polygon) = solve.polygon_errors.filter(|p| p.len() == solve.hierarchy.n_polygons as usize) {
+            for s in &mut g.sources {
+                s.mean_error = per_polygon[s.polygon as usize];
+            }
+        }
         g
     }
 
     /// The irradiance at `point` (see [`PointGather`] for the contract).
     #[must_use]
     pub fn irradiance(&self, point: &CalcPoint) -> PointIrradiance {
+        self.gather_point(point, |_| {})
+    }
+
+    /// The irradiance at `point` and the leaves its error comes from: per leaf, the share of the
+    /// photopic error that subdividing the leaf makes smaller (its radiosity taken as uniform over
+    /// it, a shadow edge across it) and the share that finer links to it make smaller (its value,
+    /// [`crate::solve::leaf_value_errors`]), W/m²; leaves that add neither are left out.
+    #[must_use]
+    pub fn irradiance_and_leaf_errors(&self, point: &CalcPoint) -> (PointIrradiance, Vec<LeafError>) {
+        let mut leaves = Vec::new();
+        let out = self.gather_point(point, |e| {
+            if e.shape > 0.0 || e.value > 0.0 {
+                leaves.push(e);
+            }
+        });
+        (out, leaves)
+    }
+
+    /// The irradiance at `point`, telling `leaf_error` each seen leaf's reducible photopic errors.
+    fn gather_point(&self, point: &CalcPoint, mut leaf_error: impl FnMut(LeafError)) -> PointIrradiance {
         let (x, n) = (point.position, point.normal);
         let tol = ON_SURFACE_REL_TOL * self.scale;
         // The half-spaces light may come from: in front of the receiver, and on the point's side of
@@ -285,12 +366,15 @@ impl<'a> PointGather<'a> {
             };
             // The error: the leaf's radiosity taken as uniform where it varies against a kernel
             // that varies, its mean's error, and a shadow edge across it.
-            let shape = seen * 0.5 * s.variation * kernel_variation(x, n, s);
+            let shape = seen * 0.5 * s.variation * kernel_variation(x, n, s.normal, s.center, s.poly.vertices());
             let shadow = if seen > 0.0 && seen < f { SHADOW_EDGE_REL_ERROR * f } else { 0.0 };
+            let value = seen * s.value_error;
+            let mean_error = if s.mean_error.is_nan() { self.mean_error } else { s.mean_error };
             for c in 0..3 {
                 out.h[c] += s.b[c] * seen;
-                out.h_err[c] += shape + self.mean_error * seen + shadow * s.b[c];
+                out.h_err[c] += shape + value + mean_error * seen + shadow * s.b[c];
             }
+            leaf_error(LeafError { leaf: s.id, shape: shape + shadow * super::photopic(s.b), value });
         }
         out.rays = shot.map_or(0, |s| s.rays);
         // Luminaires: their intensity toward the point, from the point's side of every surface it

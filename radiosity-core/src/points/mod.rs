@@ -13,8 +13,8 @@ pub mod grid;
 mod read;
 
 pub use gather::{
-    MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET, SAMPLE_SHIFT, SHADOW_DEPTH,
-    SHADOW_EDGE_REL_ERROR, UNIFORM_MAX_SUBTENSE, gather,
+    LeafError, MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET, SAMPLE_SHIFT,
+    SHADOW_DEPTH, SHADOW_EDGE_REL_ERROR, SolveParts, UNIFORM_MAX_SUBTENSE, gather,
 };
 pub use grid::{Grid, GridError, GridSpec, GridSummary};
 pub use read::{PointsError, parse_points, read_points};
@@ -80,14 +80,30 @@ impl PointIrradiance {
     }
 }
 
-/// The largest estimated error of the photopic values of `results`, relative to the largest of
-/// them (as the solve's estimate is relative to the largest polygon mean); `None` when there is
-/// no light or an error is not known.
+/// A point's error is relative to its own value, but never to less than this fraction of the
+/// largest value of its set (a point in a deep shadow is held to the accuracy of one a hundred
+/// times brighter, not without end).
+pub const POINT_FLOOR_REL: f64 = 1e-2;
+
+/// What each point's estimated error is relative to: its photopic value, at least
+/// [`POINT_FLOOR_REL`] of the largest of `results`; `None` when there is no light or an error is
+/// not known.
+#[must_use]
+pub fn error_scales(results: &[PointIrradiance]) -> Option<Vec<f64>> {
+    let top = results.iter().map(PointIrradiance::photopic).fold(0.0, f64::max);
+    if top <= 0.0 || results.iter().any(|r| !r.photopic_err().is_finite()) {
+        return None;
+    }
+    Some(results.iter().map(|r| r.photopic().max(POINT_FLOOR_REL * top)).collect())
+}
+
+/// The largest estimated error of the photopic values of `results`, each relative to its value
+/// (at least [`POINT_FLOOR_REL`] of the largest, see [`error_scales`]); `None` when there is no
+/// light or an error is not known.
 #[must_use]
 pub fn worst_relative_error(results: &[PointIrradiance]) -> Option<f64> {
-    let top = results.iter().map(PointIrradiance::photopic).fold(0.0, f64::max);
-    let worst = results.iter().map(PointIrradiance::photopic_err).try_fold(0.0f64, |w, e| e.is_finite().then_some(w.max(e)))?;
-    (top > 0.0).then_some(worst / top)
+    let scales = error_scales(results)?;
+    Some(results.iter().zip(scales).map(|(r, s)| r.photopic_err() / s).fold(0.0, f64::max))
 }
 
 #[cfg(test)]
@@ -98,11 +114,15 @@ mod tests {
         PointIrradiance { h: [h; 3], h_err: [err; 3], rays: 0 }
     }
 
-    /// The worst error relative to the largest value (grey channels: photopic = each channel).
+    /// The worst error relative to each point's value, or to the floor below it (grey channels:
+    /// photopic = each channel).
     #[test]
-    fn worst_relative_error_is_relative_to_the_largest_value() {
+    fn worst_relative_error_is_relative_to_each_value_down_to_the_floor() {
         let worst = worst_relative_error(&[point(100.0, 0.5), point(10.0, 2.0), point(50.0, 1.0)]).unwrap();
-        assert!((worst - 0.02).abs() < 1e-12, "{worst}");
+        assert!((worst - 0.2).abs() < 1e-12, "{worst}");
+        // 0.01 is below the floor (1% of 100): its error counts against 1.
+        let worst = worst_relative_error(&[point(100.0, 0.5), point(0.01, 0.03)]).unwrap();
+        assert!((worst - 0.03).abs() < 1e-12, "{worst}");
         assert_eq!(worst_relative_error(&[point(100.0, 0.5), point(10.0, f64::NAN)]), None, "an unknown error");
         assert_eq!(worst_relative_error(&[point(0.0, 0.0)]), None, "no light");
     }

@@ -34,6 +34,11 @@ pub struct ElementData {
     /// ([`ElementData::reference`]): the same eps then bounds the same relative error of the
     /// solution in a stiff enclosure as in a dim room.
     pub amplification: f64,
+    /// Per element, the factor its links' thresholds are scaled by beyond the pass's (at most 1;
+    /// empty: 1 everywhere): importance, set where calculation points need the light a leaf gets
+    /// more accurately than the polygon means do (see [`crate::pipeline::run_with_points`]).
+    /// Children inherit their parent's; an element's is at most the smallest of its descendants'.
+    pub importance: Vec<f64>,
 }
 
 /// Power leaving all surfaces over the power emitted, largest channel, for per-polygon radiosity
@@ -104,6 +109,7 @@ impl ElementData {
             irradiance: vec![h_ambient; h.len()],
             irradiance_floor: IRRADIANCE_FLOOR_REL * h_ambient,
             amplification,
+            importance: Vec::new(),
         }
     }
 
@@ -120,6 +126,26 @@ impl ElementData {
             self.variation[k as usize] = CHILD_VARIATION_FRACTION * v;
             self.irradiance[k as usize] = e;
         }
+        if !self.importance.is_empty() {
+            let w = self.importance.get(parent as usize).copied().unwrap_or(1.0);
+            self.importance.resize(n, 1.0);
+            for &k in h.children_of(parent) {
+                self.importance[k as usize] = w;
+            }
+        }
+    }
+
+    /// Scales the thresholds of links to `element` and to its ancestors by `factor` (at most 1)
+    /// more than they are now.
+    pub fn tighten(&mut self, h: &Hierarchy, element: ElementId, factor: f64) {
+        self.importance.resize(h.len(), 1.0);
+        let w = self.importance[element as usize] * factor;
+        let mut e = element;
+        while e != crate::hierarchy::NONE {
+            let slot = &mut self.importance[e as usize];
+            *slot = slot.min(w);
+            e = h.get(e).parent;
+        }
     }
 
     /// The irradiance a threshold on links to `receiver` is relative to: its reference, at least
@@ -128,5 +154,42 @@ impl ElementData {
     #[inline]
     pub fn reference(&self, receiver: ElementId) -> f64 {
         self.irradiance[receiver as usize].max(self.irradiance_floor) / self.amplification
+            * self.importance.get(receiver as usize).copied().unwrap_or(1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hierarchy::{self, BuildConfig};
+
+    /// Tightening a leaf scales the reference of the links to it and to every ancestor, and no
+    /// other element's; its children inherit its factor; a second tightening multiplies.
+    #[test]
+    fn tightening_reaches_the_ancestors_and_the_children() {
+        let scene = crate::scene::cornell_box();
+        let mut h = hierarchy::build(&scene, &BuildConfig::default());
+        let mut data = ElementData::first_guess(&h);
+        let leaf = h.leaves().find(|&l| h.get(l).polygon().is_some() && h.can_subdivide(l)).expect("a surface leaf");
+        let other = h.leaves().find(|&l| l != leaf).expect("another leaf");
+        let before: Vec<f64> = (0..h.len() as u32).map(|e| data.reference(e)).collect();
+        data.tighten(&h, leaf, 0.25);
+        let mut ancestors = vec![leaf];
+        while let Some(&a) = ancestors.last().filter(|&&a| h.get(a).parent != crate::hierarchy::NONE) {
+            ancestors.push(h.get(a).parent);
+        }
+        for e in 0..h.len() as u32 {
+            let expected = if ancestors.contains(&e) { 0.25 } else { 1.0 };
+            assert!((data.reference(e) / before[e as usize] - expected).abs() < 1e-12, "element {e}");
+        }
+        assert!((data.reference(other) - before[other as usize]).abs() < 1e-12);
+        assert!(h.subdivide(leaf));
+        data.inherit(&h, leaf);
+        for &k in h.children_of(leaf) {
+            assert_eq!(data.importance[k as usize], 0.25);
+        }
+        data.tighten(&h, leaf, 0.25);
+        assert_eq!(data.importance[leaf as usize], 0.0625);
+        assert_eq!(data.importance[h.root as usize], 0.0625);
     }
 }

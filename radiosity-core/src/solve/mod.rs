@@ -17,13 +17,13 @@ pub use cut::Cut;
 pub use direct::{direct_irradiance, direct_lower_bound, emitter_exchange};
 pub use estimate::{
     CHANGE_FACTOR_MAX, ESTIMATE_FLOOR, ESTIMATE_SAFETY, LevelHistory, NOISE_SIGMAS, ORDER_MAX, ORDER_MIN, closure_error,
-    largest_non_emitting_mean, richardson_estimate, unresolved_polygons, visibility_noise,
+    largest_non_emitting_mean, richardson_estimate, richardson_per_polygon, unresolved_polygons, visibility_noise,
 };
 pub use final_gather::{area_means, final_gather, top_down};
 pub use gmres::{GmresResult, gmres};
 pub use leaf::{HALF_MIN_TARGET, HALF_ROUNDING, LEAF_OPERATOR_MAX_BYTES, LeafCoefficients, LeafOperator, Precision, leaf_operator_entries};
 pub use operator::Operator;
-pub use ranges::element_data;
+pub use ranges::{VALUE_SERIES_FACTOR, element_data, leaf_value_errors};
 
 use crate::hierarchy::Hierarchy;
 use crate::refine::Link;

@@ -92,7 +92,96 @@ pub fn element_data(h: &Hierarchy, links: &[Link], sol: &Solution) -> ElementDat
         let e = h.get(l);
         (e.area, sol.radiosity[l as usize], h.emission_of(l))
     }));
-    ElementData { radiosity: sol.radiosity.clone(), variation, irradiance, irradiance_floor: IRRADIANCE_FLOOR_REL * mean, amplification }
+    ElementData {
+        radiosity: sol.radiosity.clone(),
+        variation,
+        irradiance,
+        irradiance_floor: IRRADIANCE_FLOOR_REL * mean,
+        amplification,
+        importance: Vec::new(),
+    }
+}
+
+/// What the value of a leaf would move by were the links to it refined further, beyond what
+/// splitting each link's source once shows: the splits that follow add about as much again (each
+/// finer split sees about half the radiosity difference of the one before, over pieces as near).
+pub const VALUE_SERIES_FACTOR: f64 = 2.0;
+
+/// Per element, how far a leaf's radiosity may be from what it would be were the sources of its
+/// links resolved (0 for every other element), W/m². Over the links to the leaf and to its
+/// ancestors: a source with children gives the leaf's centre, through the link's visibility, its
+/// children's radiosity instead of its mean (point form factors to each child), and the change
+/// from the mean's light is what one split of the link would show; times
+/// [`VALUE_SERIES_FACTOR`]. A source without children adds half its radiosity range (`variation`,
+/// see [`element_data`]) times its light times how much the kernel varies over it
+/// ([`crate::formfactor::kernel_variation`]). The sum over the links times the leaf's reflectance
+/// (largest channel). A link from a large, near source of uneven radiosity makes a leaf's value
+/// uncertain where the polygon's mean is not: the corner of a room, whose wall gets its light
+/// from a ceiling element lit unevenly. What calculation points read of such leaves
+/// ([`crate::points::PointGather`]) and what importance refines ([`crate::pipeline::run_with_points`]).
+#[must_use]
+pub fn leaf_value_errors(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], variation: &[f64]) -> Vec<f64> {
+    let index = LinksByReceiver::new(h, links);
+    let leaves: Vec<ElementId> = h.leaves().collect();
+    let errors: Vec<f64> = leaves
+        .par_iter()
+        .map(|&leaf| {
+            let e = h.get(leaf);
+            let Some(p) = e.polygon() else { return 0.0 };
+            let rho = h.reflectance[p as usize].iter().copied().fold(0.0, f64::max);
+            if rho <= 0.0 {
+                return 0.0;
+            }
+            let mut sum = 0.0;
+            let mut a = leaf;
+            while a != NONE {
+                for l in index.at(a) {
+                    if l.vis <= 0.0 {
+                        continue;
+                    }
+                    let s = h.get(l.source);
+                    let children = h.children_of(l.source);
+                    if children.is_empty() {
+                        let dv = variation.get(l.source as usize).copied().unwrap_or(0.0);
+                        if dv > 0.0 {
+                            let spread = s
+                                .poly()
+                                .map_or(1.0, |q| crate::formfactor::kernel_variation(e.center, e.normal, s.normal, s.center, q.vertices()));
+                            sum += point_to_element(h, e.center, e.normal, l.source).max(0.0) * l.vis * 0.5 * dv * spread;
+                        }
+                        continue;
+                    }
+                    // A far source is seen as its mean: its children's light differs from it by
+                    // what their kernels differ, next to nothing.
+                    let separation = (s.center - e.center).length() / (s.radius + e.radius).max(f64::MIN_POSITIVE);
+                    if separation >= PROBE_FAR_SEPARATION {
+                        continue;
+                    }
+                    let mean = radiosity[l.source as usize];
+                    let mut change = [0.0; 3];
+                    for &k in children {
+                        let c = h.get(k);
+                        let f = if (c.center - e.center).length() >= PROBE_KERNEL_SEPARATION * (c.radius + e.radius) && c.poly().is_some() {
+                            point_kernel(h, e.center, e.normal, k)
+                        } else {
+                            point_to_element(h, e.center, e.normal, k).max(0.0)
+                        } * l.vis;
+                        for c in 0..3 {
+                            change[c] += f * (radiosity[k as usize][c] - mean[c]);
+                        }
+                    }
+                    sum += VALUE_SERIES_FACTOR * change.iter().map(|v| v.abs()).fold(0.0, f64::max);
+                }
+                a = h.get(a).parent;
+            }
+            rho * sum
+        })
+        .collect();
+    let mut out = vec![0.0; h.len()];
+    for (&leaf, err) in leaves.iter().zip(errors) {
+        out[leaf as usize] = err;
+    }
+    out
 }
 
 fn max3(v: [f64; 3]) -> f64 {
