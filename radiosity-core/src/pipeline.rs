@@ -11,7 +11,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 mod importance;
-pub use importance::{IMPORTANCE_AIM, IMPORTANCE_MAX_ROUNDS, ImportanceReport};
+pub use importance::{
+    IMPORTANCE_AIM, IMPORTANCE_MAX_GROWTH, IMPORTANCE_MAX_ROUNDS, IMPORTANCE_MIN_FALL, IMPORTANCE_OUT_OF_REACH, ImportanceReport,
+};
 
 /// Settings of a full solve.
 #[derive(Clone, Copy, Debug)]
@@ -538,10 +540,14 @@ pub fn run_with_points(
     let mut point_results: Vec<Vec<crate::points::PointIrradiance>> = Vec::new();
     let mut polygon_errors: Vec<f64> = Vec::new();
     let mut rounds = 0;
+    let (mut importance_cap, mut importance_refused, mut previous_worst, mut previous_bytes) = (usize::MAX, 0u64, f64::INFINITY, 1usize);
     let max_rounds = if has_points { IMPORTANCE_MAX_ROUNDS } else { 0 };
     for level in 0..n_levels + max_rounds {
         let scale = first_scale / config.level_step.powi((level - rounds) as i32);
-        let limits = refine::RefineLimits { max_bytes: config.max_memory_bytes };
+        // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
+        let limits = refine::RefineLimits {
+            max_bytes: if rounds > 0 { config.max_memory_bytes.min(importance_cap) } else { config.max_memory_bytes },
+        };
         let mut level_solution = None;
         for pass in 1..=config.max_passes.max(1) {
             let t = Instant::now();
@@ -579,7 +585,11 @@ pub fn run_with_points(
             stats.form_factors += s.form_factors;
             stats.subdivided += s.subdivided;
             stats.dropped += s.dropped;
-            stats.refused_for_memory += s.refused_for_memory;
+            if rounds > 0 {
+                importance_refused += s.refused_for_memory;
+            } else {
+                stats.refused_for_memory += s.refused_for_memory;
+            }
             stats.links = s.links;
             passes += 1;
             if pass > 1 && s.subdivided == 0 && level_solution.is_some() {
@@ -685,8 +695,22 @@ pub fn run_with_points(
             (report.worst_after, report.met) = (round.worst, round.worst <= target);
             point_results = round.results;
             let bytes = h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK;
+            if rounds == 0 {
+                importance_cap = (bytes as f64 * IMPORTANCE_MAX_GROWTH) as usize;
+            }
+            // Out of reach: at the last round's fall and growth, the rounds still needed would
+            // take more than IMPORTANCE_OUT_OF_REACH times the cap.
+            let out_of_reach = rounds > 0 && round.worst < previous_worst && round.worst > target && {
+                let needed = (round.worst / target).ln() / (previous_worst / round.worst).ln();
+                let growth = (bytes as f64 / previous_bytes as f64).max(1.0);
+                bytes as f64 * growth.powf(needed) > IMPORTANCE_OUT_OF_REACH * importance_cap as f64
+            };
+            report.capped = importance_refused > 0 || bytes > importance_cap.min(config.max_memory_bytes) || out_of_reach;
+            report.stalled = round.worst > IMPORTANCE_MIN_FALL * previous_worst;
+            (previous_worst, previous_bytes) = (round.worst, bytes);
+            let go_on = !report.met && !report.capped && !report.stalled && rounds < max_rounds;
             let mut made = 0;
-            if !report.met && rounds < max_rounds && bytes <= config.max_memory_bytes {
+            if go_on {
                 for &leaf in &round.split {
                     if h.get(leaf).n_children == 0 && h.subdivide(leaf) {
                         data.inherit(&h, leaf);
@@ -702,7 +726,7 @@ pub fn run_with_points(
                 crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
             }
             timings.importance += t.elapsed().as_secs_f64();
-            if (made == 0 && round.tighten.is_empty()) || report.met || rounds == max_rounds || bytes > config.max_memory_bytes {
+            if !go_on || (made == 0 && round.tighten.is_empty()) {
                 break;
             }
             report.rounds += 1;

@@ -386,11 +386,14 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
             && worst > target
         {
             stats.solve_warnings.push(format!(
-                "{what}: estimated error up to {:.3}% of a point's value (or of 1% of the largest), above the target {:.3}%{}; a \
-                 smaller --target-error brings it down (see h_err)",
+                "{what}: estimated error up to {:.3}% of a point's value (or of 1% of the largest), above the target {:.3}%{} (see \
+                 h_err)",
                 100.0 * worst,
                 100.0 * target,
                 match solved.importance {
+                    Some(r) if r.capped =>
+                        format!(" after {} importance round(s), stopped at their memory cap or with the target out of its reach", r.rounds),
+                    Some(r) if r.stalled => format!(" after {} importance round(s), which stopped bringing it down", r.rounds),
                     Some(r) => format!(" after {} importance round(s)", r.rounds),
                     None => " (the levels did not meet the target, so no importance round ran)".to_owned(),
                 }
