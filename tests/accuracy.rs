@@ -229,6 +229,19 @@ fn memory_budget_stops_refinement_with_a_warning() {
     assert!(bytes <= 4 * config.max_memory_bytes, "refinement stopped near the budget: {bytes} bytes");
 }
 
+/// Calculation points at Ward's reference points (`surface, x, y, B`): on the floor facing up, on
+/// the ceiling (3 m) facing down.
+fn ward_calc_points(reference: &[(String, f64, f64, f64)]) -> Vec<radiosity::points::CalcPoint> {
+    use radiosity::geom::DVec3;
+    reference
+        .iter()
+        .map(|(surface, x, y, _)| {
+            let (z, n) = if surface == "floor" { (0.0, DVec3::Z) } else { (3.0, -DVec3::Z) };
+            radiosity::points::CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
+        })
+        .collect()
+}
+
 /// Ward's room's 480 calculation points (`reference_points.csv`, radiosity `ρ H` on the floor and
 /// ceiling), solved as `radiosity solve --points` solves them at the default settings: once the
 /// polygon means meet the target, importance rounds refine where the points' estimated errors come
@@ -240,18 +253,10 @@ fn memory_budget_stops_refinement_with_a_warning() {
 /// was 2.6% off (room corners: a point 0.25 m from two walls sees their leaves at the corner most).
 #[test]
 fn ward_room_points_within_one_percent_at_the_default_settings() {
-    use radiosity::geom::DVec3;
-    use radiosity::points::CalcPoint;
     let c = case("ward-room");
     let reference = validation::ward_room_points();
     assert_eq!(reference.len(), 480);
-    let points: Vec<CalcPoint> = reference
-        .iter()
-        .map(|(surface, x, y, _)| {
-            let (z, n) = if surface == "floor" { (0.0, DVec3::Z) } else { (3.0, -DVec3::Z) };
-            CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
-        })
-        .collect();
+    let points = ward_calc_points(&reference);
     let config = Config { target_error: Some(DEFAULT_TARGET), ..Config::default() };
     let solved = pipeline::run_with_points(&c.scene, &BfHand::default(), &config, &[&points], &|_| {});
     let report = solved.importance.expect("the points asked for importance rounds");
@@ -287,19 +292,12 @@ fn ward_room_points_within_one_percent_at_the_default_settings() {
 /// corner) for an estimate of 4.8% there.
 #[test]
 fn ward_room_point_estimates_cover_their_errors_without_importance() {
-    use radiosity::geom::DVec3;
-    use radiosity::points::{CalcPoint, PointsConfig, gather};
+    use radiosity::points::{PointsConfig, gather};
     let c = case("ward-room");
     let solved = solve_default(&c.scene);
     assert!(solved.importance.is_none() && solved.point_results.is_empty());
     let reference = validation::ward_room_points();
-    let points: Vec<CalcPoint> = reference
-        .iter()
-        .map(|(surface, x, y, _)| {
-            let (z, n) = if surface == "floor" { (0.0, DVec3::Z) } else { (3.0, -DVec3::Z) };
-            CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
-        })
-        .collect();
+    let points = ward_calc_points(&reference);
     let got = gather(&solved, &points, &PointsConfig::default());
     let mut covered = 0;
     for ((surface, _, _, b_ref), h) in reference.iter().zip(&got) {
@@ -379,19 +377,11 @@ fn partitions_standing_on_the_floor_do_not_stall_the_estimate() {
 /// 0.27%.
 #[test]
 fn importance_refines_near_the_points_only() {
-    use radiosity::geom::DVec3;
-    use radiosity::points::CalcPoint;
     let c = case("ward-room");
     let corner: Vec<(String, f64, f64, f64)> =
         validation::ward_room_points().into_iter().filter(|(_, x, y, _)| *x <= 1.25 && *y <= 1.25).collect();
     assert_eq!(corner.len(), 18);
-    let points: Vec<CalcPoint> = corner
-        .iter()
-        .map(|(surface, x, y, _)| {
-            let (z, n) = if surface == "floor" { (0.0, DVec3::Z) } else { (3.0, -DVec3::Z) };
-            CalcPoint::new(format!("{surface} {x} {y}"), DVec3::new(*x, *y, z), n).expect("finite point")
-        })
-        .collect();
+    let points = ward_calc_points(&corner);
     let config = Config { target_error: Some(DEFAULT_TARGET), ..Config::default() };
     let with = pipeline::run_with_points(&c.scene, &BfHand::default(), &config, &[&points], &|_| {});
     let without = solve_default(&c.scene);
