@@ -15,6 +15,14 @@
 //! through the links like any other light. Before refinement, surfaces are subdivided until each
 //! element subtends a small angle from every luminaire that lights it ([`MAX_ANGULAR_SIZE`]) and no
 //! shadow boundary crosses an element ([`MAX_SHADOW_DEPTH`]), so the quadrature is accurate.
+//!
+//! Where it may not be (a shadow edge of a luminaire or of the sun crossing a leaf, a luminaire
+//! nearer than the angular size allows), the leaf is sampled on its quarters as well and the
+//! difference is its quadrature error ([`update_direct`], [`Hierarchy::direct_error`]); each
+//! polygon's share ([`direct_polygon_errors`]) is in the solve's error estimate, and under a target
+//! error the levels split those leaves (or sample them finer, at the smallest element size) until
+//! every polygon's mean direct light is within a share of the target of its own value
+//! ([`direct_splits`], [`deepen_direct`]).
 
 use crate::geom::{Aabb, DVec3, PolyKind, quadrature};
 use crate::hierarchy::{ElementKind, Hierarchy, NONE};
@@ -34,6 +42,11 @@ pub const MAX_ANGULAR_DEPTH: u16 = 7;
 pub const MAX_SHADOW_DEPTH: u16 = 6;
 /// Shadow rays start this far (relative to the scene's diagonal) off the receiver, along its normal.
 pub const SHADOW_ORIGIN_OFFSET_REL: f64 = 1e-5;
+
+/// How far inside its corners (a share of the way to its centre) an element's visibility is
+/// tested, besides at its rule's points, to find shadow boundaries crossing it
+/// ([`update_direct`]).
+pub const CORNER_INSET: f64 = 1e-3;
 
 /// The quadrature rule of a surface element: 9 points on quads, 6 on triangles.
 pub(crate) fn element_rule(poly: &crate::geom::Poly) -> &'static quadrature::Rule {
@@ -237,51 +250,306 @@ pub fn prepare(h: &mut Hierarchy, lights: &Lights, caster: Option<&RayCaster>) {
 /// quadrature with shadow rays: the luminaires' illuminance in every channel, the distant
 /// sources' per channel), then every inner element's as the area mean of its children
 /// ([`crate::solve::area_means`]), so that every level carries the same power.
+///
+/// Where a shadow boundary of a luminaire or of a sharp distant source crosses a leaf (its rule's
+/// points or corners disagree on the source's visibility), or a luminaire lights it from nearer
+/// than [`MAX_ANGULAR_SIZE`] allows, the leaf's value is the area mean of the same rule over its
+/// four quarters (the children it would have), and the difference from its own rule's value is
+/// its quadrature error ([`Hierarchy::direct_error`]): a step along a shadow edge defeats the
+/// rule's polynomial accuracy, and halving the elements about halves what it misplaces (first
+/// order; a near luminaire's error falls faster), so the finer value is in error by about that
+/// difference.
 pub fn update_direct(h: &mut Hierarchy, lights: &Lights, caster: Option<&RayCaster>) {
     use rayon::prelude::*;
     let (n, start) = (h.len(), h.direct.len());
     if lights.is_empty() || start == n {
         return;
     }
-    let (luminaires, sources) = (&lights.luminaires, &lights.distant);
-    let light = DirectLight::new(luminaires, caster, h.diagonal());
-    let distant = crate::daylight::DistantLight::new(sources, caster, h.diagonal());
+    let light = DirectLight::new(&lights.luminaires, caster, h.diagonal());
+    let distant = crate::daylight::DistantLight::new(&lights.distant, caster, h.diagonal());
     let hh: &Hierarchy = h;
-    let new: Vec<[f64; 3]> = (start as u32..n as u32)
+    let new: Vec<([f64; 3], [f64; 3])> = (start as u32..n as u32)
         .into_par_iter()
         .map(|id| {
             let e = hh.get(id);
             match e.kind {
-                ElementKind::Surface { polygon, poly } if e.n_children == 0 => {
-                    let mut d = element_mean3(&poly, |x| {
-                        let lum = if luminaires.is_empty() { 0.0 } else { light.at(x, e.normal, polygon) };
-                        let d = if sources.is_empty() { [0.0; 3] } else { distant.at(x, e.normal, polygon) };
-                        d.map(|v| v + lum)
-                    });
-                    if caster.is_some() {
-                        for (k, s) in sources.iter().enumerate().filter(|(_, s)| s.sharp) {
-                            let on = s.on(e.normal);
-                            if on.iter().all(|&v| v <= 0.0) {
-                                continue;
-                            }
-                            let lit = |x: DVec3| !distant.from_one(k, x, e.normal, polygon).1;
-                            if let Some(change) = boundary_correction(&poly, lit) {
-                                for c in 0..3 {
-                                    d[c] = (d[c] + on[c] * change).max(0.0);
-                                }
-                            }
-                        }
-                    }
-                    d
-                }
-                _ => [0.0; 3],
+                ElementKind::Surface { polygon, poly } if e.n_children == 0 => leaf_direct(&poly, e.normal, polygon, &light, &distant, 1),
+                _ => ([0.0; 3], [0.0; 3]),
             }
         })
         .collect();
     let mut direct = std::mem::take(&mut h.direct);
-    direct.extend(new);
+    direct.extend(new.iter().map(|v| v.0));
+    h.direct_error.resize(start, [0.0; 3]);
+    h.direct_error.extend(new.iter().map(|v| v.1));
     crate::solve::area_means(h, &crate::solve::top_down(h), &mut direct);
     h.direct = direct;
+}
+
+/// Recomputes the direct light of surface leaves `leaves` with their quarters quartered
+/// `depth` times ([`update_direct`] does it once), each leaf's error from the same one fewer
+/// time, then every inner element's as the area mean of its children: more shadow rays where a
+/// leaf cannot be split further (the smallest element size) and its shadow edges still leave its
+/// polygon short of the target.
+pub fn deepen_direct(h: &mut Hierarchy, lights: &Lights, caster: Option<&RayCaster>, leaves: &[(u32, u32)]) {
+    use rayon::prelude::*;
+    if lights.is_empty() || leaves.is_empty() || h.direct.len() != h.len() {
+        return;
+    }
+    let light = DirectLight::new(&lights.luminaires, caster, h.diagonal());
+    let distant = crate::daylight::DistantLight::new(&lights.distant, caster, h.diagonal());
+    let hh: &Hierarchy = h;
+    let new: Vec<(u32, [f64; 3], [f64; 3])> = leaves
+        .par_iter()
+        .filter_map(|&(id, depth)| {
+            let e = hh.get(id);
+            let ElementKind::Surface { polygon, poly } = e.kind else { return None };
+            (e.n_children == 0).then(|| {
+                let (d, err) = leaf_direct(&poly, e.normal, polygon, &light, &distant, depth.max(1));
+                (id, d, err)
+            })
+        })
+        .collect();
+    let mut direct = std::mem::take(&mut h.direct);
+    h.direct_error.resize(h.len(), [0.0; 3]);
+    for (id, d, err) in new {
+        direct[id as usize] = d;
+        h.direct_error[id as usize] = err;
+    }
+    crate::solve::area_means(h, &crate::solve::top_down(h), &mut direct);
+    h.direct = direct;
+}
+
+/// A surface leaf's direct irradiance and the error estimated in it: where its rule may be
+/// inaccurate ([`rule_direct`]), the mean of the rule over its pieces quartered `depth` times
+/// (at least once), the error its difference from the same quartered one fewer time; elsewhere
+/// the rule's, with no error.
+fn leaf_direct(
+    poly: &crate::geom::Poly,
+    normal: DVec3,
+    polygon: u32,
+    light: &DirectLight<'_>,
+    distant: &crate::daylight::DistantLight<'_>,
+    depth: u32,
+) -> ([f64; 3], [f64; 3]) {
+    let rule = rule_direct(poly, normal, polygon, light, distant, false);
+    if !rule.crossed || depth == 0 {
+        return (rule.total(), [0.0; 3]);
+    }
+    // The sky's cells cast soft shadows: the rule holds for them, and only the sharp sources are
+    // sampled on the pieces.
+    let coarse = if depth == 1 { rule.sharp } else { pieces_direct(poly, normal, polygon, light, distant, depth - 1) };
+    let fine = pieces_direct(poly, normal, polygon, light, distant, depth);
+    (std::array::from_fn(|c| fine[c] + rule.soft[c]), std::array::from_fn(|c| fine[c] - coarse[c]))
+}
+
+/// The area mean of [`rule_direct`]'s sharp sources over the pieces of `poly` quartered `depth`
+/// times.
+fn pieces_direct(
+    poly: &crate::geom::Poly,
+    normal: DVec3,
+    polygon: u32,
+    light: &DirectLight<'_>,
+    distant: &crate::daylight::DistantLight<'_>,
+    depth: u32,
+) -> [f64; 3] {
+    if depth == 0 {
+        return rule_direct(poly, normal, polygon, light, distant, true).sharp;
+    }
+    let (mut sum, mut area) = ([0.0; 3], 0.0);
+    for piece in poly.subdivide() {
+        let a = piece.area();
+        let d = pieces_direct(&piece, normal, polygon, light, distant, depth - 1);
+        for c in 0..3 {
+            sum[c] += a * d[c];
+        }
+        area += a;
+    }
+    if area > 0.0 { sum.map(|v| v / area) } else { [0.0; 3] }
+}
+
+/// The direct irradiance of a surface element (polygon `polygon`, normal `normal`) by its
+/// [`element_rule`] with a shadow ray per point and source, a sharp distant source's shadow
+/// boundary sampled finer ([`boundary_correction`]); and whether the rule may be inaccurate: a
+/// shadow boundary of a luminaire or a sharp distant source crosses the element (its points or
+/// corners disagree on the source's visibility), or a luminaire that lights it is nearer than
+/// [`MAX_ANGULAR_SIZE`] allows.
+fn rule_direct(
+    poly: &crate::geom::Poly,
+    normal: DVec3,
+    polygon: u32,
+    light: &DirectLight<'_>,
+    distant: &crate::daylight::DistantLight<'_>,
+    sharp_only: bool,
+) -> RuleDirect {
+    let sources = distant.sources();
+    let mut seen_luminaire = vec![[false; 2]; light.luminaires.len()];
+    let sharp_on: Vec<bool> = sources.iter().map(|s| s.sharp && s.on(normal).iter().any(|&v| v > 0.0)).collect();
+    let mut seen_distant = vec![[false; 2]; sources.len()];
+    let (mut sharp, mut soft, mut wsum) = ([0.0; 3], [0.0; 3], 0.0);
+    for (x, w) in quadrature::weighted_points(poly, element_rule(poly)) {
+        wsum += w;
+        for (k, seen) in seen_luminaire.iter_mut().enumerate() {
+            let (v, occluded) = light.from_one(k, x, normal, polygon);
+            if v > 0.0 || occluded {
+                seen[usize::from(occluded)] = true;
+            }
+            for s in &mut sharp {
+                *s += w * v;
+            }
+        }
+        for (k, seen) in seen_distant.iter_mut().enumerate() {
+            if sharp_only && !sources[k].sharp {
+                continue;
+            }
+            let (v, occluded) = distant.from_one(k, x, normal, polygon);
+            if sharp_on[k] {
+                seen[usize::from(occluded)] = true;
+            }
+            let sum = if sources[k].sharp { &mut sharp } else { &mut soft };
+            for c in 0..3 {
+                sum[c] += w * v[c];
+            }
+        }
+    }
+    if wsum > 0.0 {
+        sharp = sharp.map(|v| v / wsum);
+        soft = soft.map(|v| v / wsum);
+    }
+    // The corners too (a hair inside): an edge that passes between the rule's outermost points
+    // and the element's side leaves every point on one side of it.
+    let centre = poly.centroid();
+    for &v in poly.vertices() {
+        let x = centre + (v - centre) * (1.0 - CORNER_INSET);
+        for (k, seen) in seen_luminaire.iter_mut().enumerate().filter(|(_, s)| !(s[0] && s[1])) {
+            let (v, occluded) = light.from_one(k, x, normal, polygon);
+            if v > 0.0 || occluded {
+                seen[usize::from(occluded)] = true;
+            }
+        }
+        for (k, seen) in seen_distant.iter_mut().enumerate().filter(|(k, s)| sharp_on[*k] && !(s[0] && s[1])) {
+            seen[usize::from(distant.from_one(k, x, normal, polygon).1)] = true;
+        }
+    }
+    // A luminaire nearer than the element's size allows (where the subdivision before refinement
+    // stopped at its depth): the rule's accuracy is not assured either.
+    let radius = poly.vertices().iter().map(|&v| (v - centre).length()).fold(0.0, f64::max);
+    let near = light
+        .luminaires
+        .iter()
+        .zip(&seen_luminaire)
+        .any(|(lum, seen)| seen[0] && radius > MAX_ANGULAR_SIZE * (centre - lum.position).length());
+    let mut crossed = near || seen_luminaire.iter().any(|s| s[0] && s[1]);
+    if light.caster.is_some() {
+        for (k, s) in sources.iter().enumerate() {
+            if !(sharp_on[k] && seen_distant[k][0] && seen_distant[k][1]) {
+                continue;
+            }
+            crossed = true;
+            let on = s.on(normal);
+            let lit = |x: DVec3| !distant.from_one(k, x, normal, polygon).1;
+            if let Some(change) = boundary_correction(poly, lit) {
+                for c in 0..3 {
+                    sharp[c] = (sharp[c] + on[c] * change).max(0.0);
+                }
+            }
+        }
+    }
+    RuleDirect { sharp, soft, crossed }
+}
+
+/// What [`rule_direct`] finds on one element: the mean direct irradiance from the sources whose
+/// shadows are sharp (luminaires, the sun) and from the others (the sky's cells), and whether the
+/// rule may be inaccurate for the sharp ones.
+struct RuleDirect {
+    sharp: [f64; 3],
+    soft: [f64; 3],
+    crossed: bool,
+}
+
+impl RuleDirect {
+    fn total(&self) -> [f64; 3] {
+        std::array::from_fn(|c| self.sharp[c] + self.soft[c])
+    }
+}
+
+/// Per input polygon and channel, the error of its mean direct irradiance that the leaves'
+/// quadrature leaves ([`Hierarchy::direct_error`], W/m² or lx): the larger of the area-weighted
+/// sum of the leaves' errors (what a shadow edge misplaces the same way all along it) and their
+/// root sum of squares (what varies in sign from leaf to leaf), over the polygon's area. Empty
+/// without luminaires or distant sources.
+#[must_use]
+pub fn direct_polygon_errors(h: &Hierarchy) -> Vec<[f64; 3]> {
+    if h.direct_error.is_empty() {
+        return Vec::new();
+    }
+    let mut sums = vec![([0.0; 3], [0.0; 3], 0.0); h.n_polygons as usize];
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        let Some(p) = e.polygon() else { continue };
+        let s = &mut sums[p as usize];
+        s.2 += e.area;
+        let Some(d) = h.direct_error.get(leaf as usize) else { continue };
+        for c in 0..3 {
+            s.0[c] += e.area * d[c];
+            s.1[c] += (e.area * d[c]).powi(2);
+        }
+    }
+    sums.into_iter()
+        .map(|(sum, squares, a)| if a > 0.0 { std::array::from_fn(|c| sum[c].abs().max(squares[c].sqrt()) / a) } else { [0.0; 3] })
+        .collect()
+}
+
+/// Below this share of the brightest polygon's mean direct irradiance, a polygon's direct error
+/// is held to this share instead of to its own mean ([`direct_splits`]): a wall the light
+/// grazes is not refined to its own faint light's precision.
+pub const DIRECT_FLOOR_REL: f64 = 1e-2;
+
+/// The leaves to split (or to sample finer where they cannot be split) so that every polygon's
+/// mean direct irradiance meets `tolerance`: those
+/// with a quadrature error ([`Hierarchy::direct_error`]) on a polygon whose error
+/// ([`direct_polygon_errors`]) exceeds `tolerance` times its own mean direct irradiance (at
+/// least [`DIRECT_FLOOR_REL`] of the largest polygon's), in the largest channel. Empty without
+/// luminaires or distant sources.
+#[must_use]
+pub fn direct_splits(h: &Hierarchy, tolerance: f64) -> Vec<u32> {
+    let errors = direct_polygon_errors(h);
+    if errors.is_empty() {
+        return Vec::new();
+    }
+    let means = polygon_direct_means(h);
+    let top = means.iter().flatten().copied().fold(0.0, f64::max);
+    let over: Vec<bool> =
+        errors.iter().zip(&means).map(|(e, m)| (0..3).any(|c| e[c] > tolerance * m[c].max(DIRECT_FLOOR_REL * top))).collect();
+    if !over.iter().any(|&o| o) {
+        return Vec::new();
+    }
+    h.leaves()
+        .filter(|&l| {
+            let e = h.get(l);
+            e.polygon().is_some_and(|p| over[p as usize]) && h.direct_error.get(l as usize).is_some_and(|d| d.iter().any(|&v| v != 0.0))
+        })
+        .collect()
+}
+
+/// Each polygon's mean direct irradiance ([`Hierarchy::direct`], area-weighted over its leaves);
+/// empty without luminaires or distant sources.
+#[must_use]
+pub fn polygon_direct_means(h: &Hierarchy) -> Vec<[f64; 3]> {
+    if h.direct.is_empty() {
+        return Vec::new();
+    }
+    let mut sums = vec![([0.0; 3], 0.0); h.n_polygons as usize];
+    for leaf in h.leaves() {
+        let e = h.get(leaf);
+        let (Some(p), Some(d)) = (e.polygon(), h.direct.get(leaf as usize)) else { continue };
+        let s = &mut sums[p as usize];
+        s.1 += e.area;
+        for c in 0..3 {
+            s.0[c] += e.area * d[c];
+        }
+    }
+    sums.into_iter().map(|(d, a)| if a > 0.0 { d.map(|v| v / a) } else { [0.0; 3] }).collect()
 }
 
 /// Points per side of the grid on which a sharp distant source's shadow boundary is sampled

@@ -81,6 +81,7 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         twin,
         min_area: config.min_area_rel * total_area,
         direct: Vec::new(),
+        direct_error: Vec::new(),
     };
     let centroids: Vec<DVec3> = h.elements.iter().map(|e| e.center).collect();
     h.root = build_cluster(&mut h, &centroids, 0, n, 0, config.max_leaf_polygons.max(2));

@@ -125,6 +125,10 @@ pub struct Hierarchy {
     /// does not hold: [`crate::light::Lights`]) per element and channel (the area mean over the
     /// element), filled by [`crate::luminaire::update_direct`]; empty without either.
     pub direct: Vec<[f64; 3]>,
+    /// Per element, what its [`Hierarchy::direct`] is estimated to be in error by from the
+    /// quadrature (signed, per channel; zero where no shadow boundary crosses it): meaningful for
+    /// leaves; filled with it.
+    pub direct_error: Vec<[f64; 3]>,
 }
 
 impl Hierarchy {
