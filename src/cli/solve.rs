@@ -385,9 +385,21 @@ pub fn run(args: &SolveArgs) -> anyhow::Result<()> {
         if let (Some(target), Some(worst)) = (config.target_error, radiosity::points::worst_relative_error(results))
             && worst > target
         {
+            // What the sky's cells alone leave, which no refinement lowers.
+            let sky = radiosity::points::error_scales(results)
+                .map(|s| results.iter().zip(s).map(|(r, s)| radiosity::points::photopic(r.sky_err) / s).fold(0.0, f64::max))
+                .unwrap_or(0.0);
+            let sky = if sky > target {
+                format!(
+                    "; the sky's cells alone leave up to {:.3}% (more `directions` in [sky] lower it, refinement does not)",
+                    100.0 * sky
+                )
+            } else {
+                String::new()
+            };
             stats.solve_warnings.push(format!(
-                "{what}: estimated error up to {:.3}% of a point's value (or of 1% of the largest), above the target {:.3}%{} (see \
-                 h_err)",
+                "{what}: estimated error up to {:.3}% of a point's value (or of 1% of the largest), above the target {:.3}%{}{sky} \
+                 (see h_err)",
                 100.0 * worst,
                 100.0 * target,
                 match solved.importance {

@@ -77,7 +77,8 @@ pub(super) struct Round {
     /// Each set's points, their estimated error (`h_err`) at least what they moved since the
     /// round before.
     pub results: Vec<Vec<PointIrradiance>>,
-    /// The worst estimated error of a point, relative to its value (or the floor, see
+    /// The worst estimated error of a point that refinement can lower (all but the sky's
+    /// discretisation), relative to its value (or the floor, see
     /// [`crate::points::error_scales`]).
     pub worst: f64,
     /// Leaves to subdivide, sorted, without repeats.
@@ -116,7 +117,8 @@ pub(super) fn round(
             continue;
         };
         for ((r, leaves), scale) in results.into_iter().zip(scales) {
-            let err = r.photopic_err();
+            // The sky's discretisation is the sky's: no round lowers it.
+            let err = r.refinable_err();
             out.worst = out.worst.max(err / scale);
             let limit = target * scale;
             if err <= limit {

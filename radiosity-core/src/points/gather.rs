@@ -178,8 +178,9 @@ pub struct SolveParts<'a> {
 /// for a leaf seen in part. Measured on the 1990 test room's 480 points (`tests/accuracy.rs`): at
 /// the default target every point's true error is within its estimate plus the reference's 0.2%,
 /// with importance rounds (the worst point's estimate 2.2 times its error) and without. The
-/// luminaires' and distant sources' direct light (one ray each) adds none: a luminaire's is exact
-/// for the point-source model, and the sky's discretisation is not counted yet.
+/// luminaires' and the sun's direct light (one ray each) adds none: a luminaire's is exact for the
+/// point-source model. The sky's cells add their discretisation ([`PointIrradiance::sky_err`]:
+/// [`SKY_PROBES`] more rays across each cell, [`SKY_ERROR_FACTOR`]).
 pub struct PointGather<'a> {
     h: &'a Hierarchy,
     caster: Option<&'a RayCaster>,
@@ -400,8 +401,13 @@ impl<'a> PointGather<'a> {
             }
         }
         // Distant sources (sun, sky cells): their beam, from the point's side of every surface it
-        // lies on, with one shadow ray each.
+        // lies on, with one shadow ray each. A sky cell stands for a patch of sky the ray through
+        // its middle sees all or none of: [`SKY_PROBES`] more rays across the patch tell how much
+        // of it the point may see instead (see [`PointIrradiance::sky_err`]).
         let far = crate::daylight::FAR_REL * self.scale;
+        let cells = distant.iter().filter(|s| !s.sharp).count();
+        let spread = SKY_PROBE_SPREAD * (2.0 / cells.max(1) as f64).sqrt();
+        let mut sky_off = [0.0; 3];
         for s in distant {
             if (0..sides.len).any(|k| sides.normals[k].dot(s.toward) >= 0.0) {
                 continue;
@@ -410,19 +416,60 @@ impl<'a> PointGather<'a> {
             if e.iter().all(|&v| v <= 0.0) {
                 continue;
             }
+            let mut lit = true;
             if let Some(caster) = self.caster {
                 out.rays += 1;
-                if !caster.segment_clear(origin, origin - s.toward * far, NONE, NONE) {
-                    continue;
+                lit = caster.segment_clear(origin, origin - s.toward * far, NONE, NONE);
+                if !s.sharp {
+                    let (u, v) = s.toward.any_orthonormal_pair();
+                    let (mut seen, mut probes) = (u32::from(lit), 1u32);
+                    for (a, b) in SKY_PROBES {
+                        let d = (s.toward + spread * (a * u + b * v)).normalize();
+                        // A probe below the point's horizon looks at what the point lies on.
+                        if (0..sides.len).any(|k| sides.normals[k].dot(d) >= 0.0) {
+                            continue;
+                        }
+                        out.rays += 1;
+                        probes += 1;
+                        seen += u32::from(caster.segment_clear(origin, origin - d * far, NONE, NONE));
+                    }
+                    let share = f64::from(seen) / f64::from(probes);
+                    let off = (f64::from(u32::from(lit)) - share).abs();
+                    for c in 0..3 {
+                        sky_off[c] += off * e[c];
+                    }
                 }
+            }
+            if !lit {
+                continue;
             }
             for c in 0..3 {
                 out.h[c] += e[c];
             }
         }
+        for c in 0..3 {
+            out.sky_err[c] = SKY_ERROR_FACTOR * sky_off[c];
+            out.h_err[c] += out.sky_err[c];
+        }
         out
     }
 }
+
+/// Where, besides its middle, a sky cell is probed from a calculation point: offsets along two
+/// directions across the cell, in units of [`SKY_PROBE_SPREAD`] times the cell's angular radius.
+pub const SKY_PROBES: [(f64, f64); 4] = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
+/// How far across its cell a sky probe looks, as a share of the angular radius of a cell (the cap
+/// of the cell's solid angle, `√(2/n)` for `n` cells over the hemisphere).
+pub const SKY_PROBE_SPREAD: f64 = 1.0;
+/// A point's sky error ([`PointIrradiance::sky_err`]) is this times the sum over the cells of how
+/// far the middle ray's verdict is from the share of the rays (the middle one and the probes above
+/// the point's horizon) that see the sky, times the
+/// cell's irradiance (a straight occluder's edge crosses a row of cells alike: their errors add).
+/// Measured under a 1 m black square over a black ground and the uniform 145-cell sky (120 points,
+/// the square 0.3, 1 and 3 m up, `tests/points.rs`): the estimate covers 108, 120 and 112 of the
+/// errors against the continuous sky (up to 14.8%, 5.5% and 2.4%), on the whole 3.6, 4.0 and 2.6
+/// times them. The points it misses see a cell in part that all five rays call seen (or hidden).
+pub const SKY_ERROR_FACTOR: f64 = 1.5;
 
 /// Whether `x` (near the plane of `poly`, unit normal `normal`) lies within `tol` of the polygon's
 /// area: inside every edge, or no farther than `tol` outside it.

@@ -61,6 +61,10 @@ pub struct PointIrradiance {
     /// The estimated error of `h` per channel, W/m² (see [`PointGather`]'s contract); NaN where
     /// the solve has no error estimate to start from.
     pub h_err: [f64; 3],
+    /// The part of [`PointIrradiance::h_err`] that comes from the sky's discretisation into
+    /// cells, each seen or not along the ray through its middle (W/m², per channel): what a finer
+    /// sky (more `directions`) lowers, and refinement does not.
+    pub sky_err: [f64; 3],
     /// Visibility rays cast for this point (0 where none were needed).
     pub rays: u64,
 }
@@ -77,6 +81,13 @@ impl PointIrradiance {
     #[must_use]
     pub fn photopic_err(&self) -> f64 {
         photopic(self.h_err)
+    }
+
+    /// The part of [`PointIrradiance::photopic_err`] that refinement can lower: all of it but
+    /// the sky's discretisation ([`PointIrradiance::sky_err`]).
+    #[must_use]
+    pub fn refinable_err(&self) -> f64 {
+        (photopic(self.h_err) - photopic(self.sky_err)).max(0.0)
     }
 }
 
@@ -111,7 +122,7 @@ mod tests {
     use super::*;
 
     fn point(h: f64, err: f64) -> PointIrradiance {
-        PointIrradiance { h: [h; 3], h_err: [err; 3], rays: 0 }
+        PointIrradiance { h: [h; 3], h_err: [err; 3], sky_err: [0.0; 3], rays: 0 }
     }
 
     /// The worst error relative to each point's value, or to the floor below it (grey channels:
