@@ -483,12 +483,13 @@ pub fn run_with_points(
     let mut h = hierarchy::build(scene, &config.build);
     let caster = RayCaster::new(scene);
     let lights = scene.lights();
+    let direct_caster = config.use_visibility.then_some(&caster);
     // Luminaires: surfaces split for their light, every element's direct illuminance.
-    crate::luminaire::prepare(&mut h, &lights, config.use_visibility.then_some(&caster));
+    crate::luminaire::prepare(&mut h, &lights, direct_caster);
     // Both sides of a transmitting leaf are cut into the same pieces (here and after every
     // refinement), so each piece passes its light through to the piece behind it.
     if !h.match_sides().is_empty() {
-        crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
+        crate::luminaire::update_direct(&mut h, &lights, direct_caster);
     }
     let shaft_objects = match effective_visibility(oracle, config.visibility_method) {
         VisibilityMethod::Shafts(volume) if use_visibility => Some(crate::visibility::shaft::ShaftObjects::new(
@@ -581,17 +582,9 @@ pub fn run_with_points(
                 s.form_factors += form_factors;
                 s.links = links.len() as u64;
             }
-            crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
             let direct_limit = limits.max_bytes.saturating_sub(links.len() * refine::BYTES_PER_LINK);
-            s.subdivided += refine_direct(
-                &mut h,
-                &mut data,
-                &mut quadrature,
-                &lights,
-                config.use_visibility.then_some(&caster),
-                direct_tolerance(target_error, scale),
-                direct_limit,
-            );
+            let direct_tolerance = direct_tolerance(target_error, scale);
+            s.subdivided += refine_direct(&mut h, &mut data, &mut quadrature, &lights, direct_caster, direct_tolerance, direct_limit);
             timings.refine += t.elapsed().as_secs_f64();
             stats.oracle_calls += s.oracle_calls;
             stats.form_factors += s.form_factors;
@@ -735,14 +728,13 @@ pub fn run_with_points(
                 for e in h.match_sides() {
                     data.inherit(&h, e);
                 }
-                crate::luminaire::update_direct(&mut h, &lights, config.use_visibility.then_some(&caster));
                 let direct_limit = config.max_memory_bytes.min(importance_cap).saturating_sub(links.len() * refine::BYTES_PER_LINK);
                 refine_direct(
                     &mut h,
                     &mut data,
                     &mut quadrature,
                     &lights,
-                    config.use_visibility.then_some(&caster),
+                    direct_caster,
                     direct_tolerance(target_error, scale),
                     direct_limit,
                 );
@@ -944,8 +936,9 @@ fn direct_tolerance(target: Option<f64>, scale: f64) -> Option<f64> {
     target.map(|t| DIRECT_SHARE_OF_TARGET * t * scale.min(1.0))
 }
 
-/// Splits the leaves whose direct light's quadrature keeps a polygon's mean direct irradiance
-/// from `tolerance` of its own ([`crate::luminaire::direct_splits`]), and computes the new
+/// Computes the direct light of the leaves made since the last call
+/// ([`crate::luminaire::update_direct`]), then splits the leaves whose direct light's quadrature
+/// keeps a polygon's mean direct irradiance from `tolerance` of its own ([`crate::luminaire::direct_splits`]), and computes the new
 /// leaves' direct light, until none does, for [`DIRECT_MAX_ROUNDS`] rounds or until the elements
 /// would take more than `max_bytes`; a leaf at the smallest element size is sampled finer
 /// instead ([`crate::luminaire::deepen_direct`], its depth in `quadrature`, up to
@@ -960,6 +953,7 @@ fn refine_direct(
     tolerance: Option<f64>,
     max_bytes: usize,
 ) -> u64 {
+    crate::luminaire::update_direct(h, lights, caster);
     let Some(tolerance) = tolerance else { return 0 };
     let mut made = 0;
     for _ in 0..DIRECT_MAX_ROUNDS {
