@@ -12,11 +12,22 @@ pub struct BuildConfig {
     pub max_leaf_polygons: usize,
     /// Smallest surface element area, relative to the scene's total area.
     pub min_area_rel: f64,
+    /// How many times every polygon may be quartered whatever `min_area_rel` says: a polygon
+    /// smaller than `4^min_polygon_depth` times the smallest element may still be split into
+    /// pieces of `4^-min_polygon_depth` of its own area. With it the smallest element is no
+    /// longer relative to the scene's size alone, which grows with the number of leaves in a
+    /// canopy while each leaf stays the same: 3,200 leaves of 10 cm over a 10 m ground (164 m²)
+    /// may be quartered twice only, too coarse for the light two leaves 1 cm apart or crossing
+    /// each other exchange, and the levels stall (an estimate of 4.1% after 4 M links; 0.88% after
+    /// 1.7 M links with every leaf quartered 4 times). 0 (off) by default: on two crossing leaves
+    /// the first level then meets the target with an estimate of 0.07% while their NIR absorbed
+    /// power is 1.1% below an independent photon tracer's, an error the estimate does not see yet.
+    pub min_polygon_depth: u8,
 }
 
 impl Default for BuildConfig {
     fn default() -> Self {
-        BuildConfig { max_leaf_polygons: 4, min_area_rel: 2e-6 }
+        BuildConfig { max_leaf_polygons: 4, min_area_rel: 2e-6, min_polygon_depth: 0 }
     }
 }
 
@@ -80,6 +91,7 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         transmittance,
         twin,
         min_area: config.min_area_rel * total_area,
+        min_piece_rel: 0.25f64.powi(i32::from(config.min_polygon_depth)),
         direct: Vec::new(),
         direct_error: Vec::new(),
     };

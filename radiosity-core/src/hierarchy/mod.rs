@@ -119,8 +119,11 @@ pub struct Hierarchy {
     /// `E + ρ·H(this side) + t·H(other side)`, the other side's irradiance at the same piece
     /// ([`Hierarchy::mate`]).
     pub twin: Vec<u32>,
-    /// Smallest area a surface element may be subdivided into.
+    /// Smallest area a surface element may be subdivided into (but see `min_piece_rel`).
     pub min_area: f64,
+    /// Every polygon may be subdivided down to this fraction of its own area even where that is
+    /// below `min_area` ([`BuildConfig::min_polygon_depth`]).
+    pub min_piece_rel: f64,
     /// Direct irradiance from the scene's luminaires and distant sources (which the hierarchy
     /// does not hold: [`crate::light::Lights`]) per element and channel (the area mean over the
     /// element), filled by [`crate::luminaire::update_direct`]; empty without either.
@@ -160,11 +163,18 @@ impl Hierarchy {
     }
 
     /// Whether `id` can be subdivided: clusters always (they have children), surfaces while their
-    /// children would not fall below `min_area`.
+    /// children would not fall below [`Hierarchy::smallest_piece`] of their polygon.
     #[must_use]
     pub fn can_subdivide(&self, id: ElementId) -> bool {
         let e = self.get(id);
-        e.n_children > 0 || (!e.is_cluster() && e.area * 0.25 >= self.min_area)
+        e.n_children > 0 || matches!(e.kind, ElementKind::Surface { polygon, .. } if e.area * 0.25 >= self.smallest_piece(polygon))
+    }
+
+    /// The smallest area a piece of input polygon `polygon` may have: `min_area`, or
+    /// `min_piece_rel` of the polygon's own area where that is smaller.
+    #[must_use]
+    pub fn smallest_piece(&self, polygon: u32) -> f64 {
+        self.min_area.min(self.min_piece_rel * self.elements[polygon as usize].area)
     }
 
     /// Creates the 4 children of surface `id` if it has none yet (lazy regular subdivision).
@@ -177,7 +187,7 @@ impl Hierarchy {
         let ElementKind::Surface { polygon, poly } = e.kind else {
             return false;
         };
-        if e.area * 0.25 < self.min_area {
+        if e.area * 0.25 < self.smallest_piece(polygon) {
             return false;
         }
         let depth = e.depth + 1;
@@ -402,6 +412,35 @@ mod tests {
         let mut config = BuildConfig::default();
         config.min_area_rel = 1e-4;
         build(&scene, &config)
+    }
+
+    /// A 10 cm leaf over a 10 m ground: the smallest element relative to the scene (2e-6 of its
+    /// 100.01 m²) lets the leaf be quartered twice; with `min_polygon_depth` 4 it may be quartered
+    /// four times, and the ground, whose pieces stay above the scene's smallest element anyway,
+    /// as deep as before.
+    #[test]
+    fn a_small_polygon_may_be_quartered_min_polygon_depth_times() {
+        let mut b = SceneBuilder::new(std::path::Path::new("test"), "test");
+        let m = b.material(Material::diffuse("grey", [0.5; 3])).unwrap();
+        let g = b.group("g");
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        b.face(&[c(-5., -5., 0.), c(5., -5., 0.), c(5., 5., 0.), c(-5., 5., 0.)], m, g, 0).unwrap();
+        b.face(&[c(0., 0., 1.), c(0.1, 0., 1.), c(0.1, 0.1, 1.), c(0., 0.1, 1.)], m, g, 0).unwrap();
+        let scene = b.finish();
+        let depth_reached = |h: &mut Hierarchy, polygon: u32| {
+            let (mut e, mut depth) = (polygon, 0);
+            while h.can_subdivide(e) && h.subdivide(e) {
+                e = h.children_of(e)[0];
+                depth += 1;
+            }
+            depth
+        };
+        for (min_polygon_depth, leaf_depth) in [(0u8, 2), (4, 4), (6, 6)] {
+            let mut h = build(&scene, &BuildConfig { min_polygon_depth, ..BuildConfig::default() });
+            assert_eq!(depth_reached(&mut h, 1), leaf_depth, "min_polygon_depth {min_polygon_depth}");
+            // The ground: 100 m² down to 2e-4 m² pieces, 4^-9 of it, whatever the setting.
+            assert_eq!(depth_reached(&mut h, 0), 9, "min_polygon_depth {min_polygon_depth}");
+        }
     }
 
     /// Both sides end up cut into the same pieces wherever either side was cut, and every piece's
