@@ -233,7 +233,6 @@ pub struct DistantLight<'a> {
     sources: &'a [DistantSource],
     caster: Option<&'a RayCaster>,
     offset: f64,
-    far: f64,
 }
 
 impl<'a> DistantLight<'a> {
@@ -246,12 +245,7 @@ impl<'a> DistantLight<'a> {
     /// `caster` `None`: no occlusion.
     #[must_use]
     pub fn new(sources: &'a [DistantSource], caster: Option<&'a RayCaster>, scene_diagonal: f64) -> DistantLight<'a> {
-        DistantLight {
-            sources,
-            caster,
-            offset: crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * scene_diagonal,
-            far: FAR_REL * scene_diagonal.max(f64::MIN_POSITIVE),
-        }
+        DistantLight { sources, caster, offset: crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * scene_diagonal }
     }
 
     /// Whether a ray from `x` (normal `n`, on polygon `skip`) against the light of source `k`
@@ -264,7 +258,7 @@ impl<'a> DistantLight<'a> {
             return ([0.0; 3], false);
         }
         match self.caster {
-            Some(caster) if !caster.segment_clear(x + self.offset * n, x - s.toward * self.far, skip, NONE) => ([0.0; 3], true),
+            Some(caster) if !caster.ray_clear_skipping(x + self.offset * n, -s.toward, skip) => ([0.0; 3], true),
             _ => (e, false),
         }
     }

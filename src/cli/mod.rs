@@ -96,7 +96,8 @@ pub struct CommonOptions {
     /// Seed of the visibility sampling.
     #[arg(long, default_value_t = radiosity::visibility::VisibilityConfig::default().seed)]
     pub seed: u64,
-    /// Smallest element, as a fraction of the scene's total area.
+    /// Smallest element, as a fraction of the scene's total area (every polygon may still be quartered
+    /// 6 times, down to 1/4096 of its own area).
     #[arg(long, default_value_t = radiosity::hierarchy::BuildConfig::default().min_area_rel)]
     pub min_area: f64,
     /// Accept a scene with no emitter.

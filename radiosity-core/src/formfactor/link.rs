@@ -191,6 +191,47 @@ pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) 
     points.into_iter().all(|v| plane.normal.dot(v - origin) <= tol)
 }
 
+/// Whether surface elements `a` and `b` cross each other, as two leaves through each other do:
+/// each reaches through the other's plane (vertices strictly on both sides of it, beyond the
+/// tolerance of [`behind_surface`]) and an edge of one passes through the other. (For convex
+/// polygons that straddle each other's planes, both cuts lie on the planes' common line, and they
+/// overlap exactly when an edge of one meets the other.) False when either is a cluster.
+#[must_use]
+pub fn surfaces_cross(a: &Element, b: &Element) -> bool {
+    let (Some(pa), Some(pb)) = (a.poly(), b.poly()) else { return false };
+    // Signed distances of `other`'s vertices to `plane`'s plane, and whether they straddle it.
+    let straddles = |plane: &Element, p: &Poly, other: &Poly| -> bool {
+        let o = p.v[0];
+        let flatness = p.vertices().iter().map(|&v| plane.normal.dot(v - o).abs()).fold(0.0, f64::max);
+        let tol = (ON_PLANE_REL_TOL * plane.radius).max(flatness);
+        let (mut front, mut back) = (false, false);
+        for &v in other.vertices() {
+            let d = plane.normal.dot(v - o);
+            front |= d > tol;
+            back |= d < -tol;
+        }
+        front && back
+    };
+    if !straddles(a, pa, pb) || !straddles(b, pb, pa) {
+        return false;
+    }
+    // Whether an edge of `p` passes through the convex polygon `q` (normal `n`).
+    let edge_through = |p: &Poly, q: &Poly, n: DVec3| -> bool {
+        let (pv, qv) = (p.vertices(), q.vertices());
+        let o = qv[0];
+        (0..pv.len()).any(|i| {
+            let (x0, x1) = (pv[i], pv[(i + 1) % pv.len()]);
+            let (d0, d1) = (n.dot(x0 - o), n.dot(x1 - o));
+            if (d0 > 0.0) == (d1 > 0.0) || d0 == d1 {
+                return false;
+            }
+            let x = x0 + (x1 - x0) * (d0 / (d0 - d1));
+            (0..qv.len()).all(|k| n.dot((qv[(k + 1) % qv.len()] - qv[k]).cross(x - qv[k])) >= 0.0)
+        })
+    };
+    edge_through(pa, pb, b.normal) || edge_through(pb, pa, a.normal)
+}
+
 /// Clusters with at most this many polygons use their members' exact projected area in the link
 /// direction; larger ones the isotropic `A/4`.
 pub const CLUSTER_EXACT_MAX_POLYGONS: usize = 1024;

@@ -12,6 +12,6 @@ mod point_polygon;
 pub use contour::polygon_polygon;
 pub use link::{
     FAR_SEPARATION, FormFactorQuality, MAX_PROBE_PULL, NEAR_SEPARATION, ON_PLANE_REL_TOL, behind_surface, estimate, estimate_max,
-    link_form_factor, point_to_element, projected_area,
+    link_form_factor, point_to_element, projected_area, surfaces_cross,
 };
 pub use point_polygon::{clip_to_halfspace, kernel_variation, point_polygon, point_polygon_unclipped};

@@ -8,7 +8,7 @@
 
 mod build;
 
-pub use build::{BuildConfig, TWIN_REL_TOL, build, twins};
+pub use build::{BuildConfig, MIN_POLYGON_DEPTH, TWIN_REL_TOL, build, twins};
 
 use crate::geom::{Aabb, DVec3, Poly};
 

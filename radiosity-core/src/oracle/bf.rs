@@ -3,8 +3,9 @@
 //! The three make the same decisions (the equivalence tests compare links and radiosity bit for
 //! bit); every threshold is `eps` times the receiver's own irradiance ([`crate::refine::LinkCtx::threshold`]):
 //! 1. pairs that cannot see each other's front are dropped;
-//! 2. a link with a cluster at one end whose elements are too near for the cluster approximation
-//!    ([`crate::refine::LinkCtx::clusters_too_near`]) is subdivided;
+//! 2. a link with a cluster at one end whose elements are too near for the cluster approximation,
+//!    or between two surfaces that cross each other ([`crate::refine::LinkCtx::too_near`]), is
+//!    subdivided;
 //! 3. a link whose whole transfer `B_S · F_max` is within the threshold is kept;
 //! 4. otherwise it is subdivided while the cluster approximation's error
 //!    ([`super::tools::ClusterError`]) exceeds the threshold, then, splitting the source, while the

@@ -38,14 +38,14 @@ impl Oracle for BfHand {
 
 /// The BF decision (the graph of [`crate::oracle::bf`], written out): drop pairs that cannot see
 /// each other's front; subdivide a cluster link whose elements are too near for the cluster
-/// approximation; link when `B_S · F_max` is within the threshold; otherwise subdivide while the
+/// approximation, and two surfaces that cross each other; link when `B_S · F_max` is within the threshold; otherwise subdivide while the
 /// cluster approximation's error exceeds it, then (the source) while the source-variation error
 /// does, then while the partial-visibility error does; link when none does.
 pub fn bf_decide(ctx: &mut LinkCtx<'_>, params: &BfParams) -> Decision {
     if !ctx.facing() {
         return Decision::Stop;
     }
-    if ctx.clusters_too_near() {
+    if ctx.too_near() {
         return split(ctx);
     }
     let threshold = ctx.threshold(params.eps);

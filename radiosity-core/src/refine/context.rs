@@ -346,6 +346,28 @@ impl<'a> LinkCtx<'a> {
         (s.is_cluster() || r.is_cluster()) && (s.center - r.center).length() < CLUSTER_NEAR_FACTOR * (s.radius + r.radius)
     }
 
+    /// Whether the two are surfaces that cross each other ([`formfactor::surfaces_cross`]) with
+    /// centres nearer than [`formfactor::NEAR_SEPARATION`] times the sum of their radii: leaves
+    /// through leaves. The light they exchange gathers along the crossing line, where the kernel
+    /// has no scale, and a link between them shares its transfer out over their pieces by the
+    /// shape of its form factor alone: two crossing 10 cm leaves linked whole absorbed 1.1% less
+    /// NIR than an independent photon tracer finds, an error no coarsening of the mesh shows.
+    #[must_use]
+    pub fn surfaces_cross(&self) -> bool {
+        let (s, r) = (self.emitter_element(), self.receiver_element());
+        !s.is_cluster()
+            && !r.is_cluster()
+            && (s.center - r.center).length() < formfactor::NEAR_SEPARATION * (s.radius + r.radius)
+            && formfactor::surfaces_cross(s, r)
+    }
+
+    /// Too near for a link: [`LinkCtx::clusters_too_near`] or [`LinkCtx::surfaces_cross`]; the
+    /// pair is subdivided while it can be.
+    #[must_use]
+    pub fn too_near(&self) -> bool {
+        self.clusters_too_near() || self.surfaces_cross()
+    }
+
     /// Smallest and largest point-to-emitter form factor over the receiver, at the centre and near
     /// each corner (the probe points of [`formfactor::estimate_max`]); both equal the cluster
     /// estimate when a cluster is involved (memoised).

@@ -237,6 +237,9 @@ pub(super) fn local_pipeline(config: &InstancedConfig) -> pipeline::Config {
         solve: config.local_solve,
         leaf_operator_max_bytes: config.local_leaf_operator_max_bytes,
         stream_leaf_operator: false,
+        // The instanced levels and their flattened reference keep the smallest element relative
+        // to the scene alone, as their costs, proxies and tolerances were measured with it.
+        build: crate::hierarchy::BuildConfig { min_polygon_depth: 0, ..config.pipeline.build },
         ..config.pipeline
     }
 }

@@ -37,8 +37,8 @@ impl Tool for Facing {
     }
 }
 
-/// Is a cluster involved and the pair too near for the isotropic approximation
-/// ([`LinkCtx::clusters_too_near`])?
+/// Is the pair too near for a link ([`LinkCtx::too_near`]): a cluster involved and the pair too
+/// near for the isotropic approximation, or two surfaces crossing each other?
 #[derive(Clone, Copy, Debug)]
 pub struct ClusterTooNear;
 
@@ -46,7 +46,7 @@ impl Tool for ClusterTooNear {
     type Answer = YesNo;
     #[inline]
     fn ask(&self, ctx: &mut LinkCtx<'_>) -> YesNo {
-        YesNo::from_bool(ctx.clusters_too_near())
+        YesNo::from_bool(ctx.too_near())
     }
 }
 
