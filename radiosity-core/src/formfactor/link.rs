@@ -176,6 +176,13 @@ pub const ON_PLANE_REL_TOL: f64 = 1e-9;
 /// ([`crate::refine::LinkCtx::facing`]) and of [`link_form_factor`].
 #[must_use]
 pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) -> bool {
+    let Some((origin, tol)) = plane_of(plane) else { return false };
+    points.into_iter().all(|v| plane.normal.dot(v - origin) <= tol)
+}
+
+/// A point of element `plane`'s plane and how far off it a point may lie and still count as on
+/// it; `None` for a cluster whose polygons do not share one plane facing one way.
+fn plane_of(plane: &Element) -> Option<(DVec3, f64)> {
     let (origin, flatness) = match plane.poly() {
         // A quad is planar only up to the loaders' tolerance (its vertices as written, rounded
         // to a few decimals): a point counts as on its plane as long as it is no farther from it
@@ -185,10 +192,9 @@ pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) 
         Some(p) => (p.v[0], p.vertices().iter().map(|&v| plane.normal.dot(v - p.v[0]).abs()).fold(0.0, f64::max)),
         // A flat cluster (all its polygons in one plane, one way) has its centre in that plane.
         None if plane.normal != DVec3::ZERO => (plane.center, 0.0),
-        None => return false,
+        None => return None,
     };
-    let tol = (ON_PLANE_REL_TOL * plane.radius).max(flatness);
-    points.into_iter().all(|v| plane.normal.dot(v - origin) <= tol)
+    Some((origin, (ON_PLANE_REL_TOL * plane.radius).max(flatness)))
 }
 
 /// Whether surface elements `a` and `b` cross each other, as two leaves through each other do:
@@ -199,20 +205,13 @@ pub fn behind_surface(plane: &Element, points: impl IntoIterator<Item = DVec3>) 
 #[must_use]
 pub fn surfaces_cross(a: &Element, b: &Element) -> bool {
     let (Some(pa), Some(pb)) = (a.poly(), b.poly()) else { return false };
-    // Signed distances of `other`'s vertices to `plane`'s plane, and whether they straddle it.
-    let straddles = |plane: &Element, p: &Poly, other: &Poly| -> bool {
-        let o = p.v[0];
-        let flatness = p.vertices().iter().map(|&v| plane.normal.dot(v - o).abs()).fold(0.0, f64::max);
-        let tol = (ON_PLANE_REL_TOL * plane.radius).max(flatness);
-        let (mut front, mut back) = (false, false);
-        for &v in other.vertices() {
-            let d = plane.normal.dot(v - o);
-            front |= d > tol;
-            back |= d < -tol;
-        }
-        front && back
+    // Whether `other`'s vertices lie strictly on both sides of `plane`'s plane.
+    let straddles = |plane: &Element, other: &Poly| -> bool {
+        let Some((o, tol)) = plane_of(plane) else { return false };
+        let d = |v: &DVec3| plane.normal.dot(*v - o);
+        other.vertices().iter().any(|v| d(v) > tol) && other.vertices().iter().any(|v| d(v) < -tol)
     };
-    if !straddles(a, pa, pb) || !straddles(b, pb, pa) {
+    if !straddles(a, pb) || !straddles(b, pa) {
         return false;
     }
     // Whether an edge of `p` passes through the convex polygon `q` (normal `n`).

@@ -250,23 +250,24 @@ impl RayCaster {
     #[must_use]
     pub fn ray_clear_skipping(&self, origin: DVec3, dir: DVec3, skip: u32) -> bool {
         self.rays_cast.add(1);
-        if self.triangles.is_empty() {
-            return true;
-        }
-        let ray = Ray::new(self.to_local(origin), ray_direction(dir), 0.0, f32::INFINITY);
-        self.bvh
-            .ray_traverse_miss(ray, |ray, id| if self.tri_polygon[id] == skip { f32::INFINITY } else { self.triangles[id].intersect(ray) })
+        self.ray_clear_skipping_uncounted(origin, dir, skip)
     }
 
     /// [`RayCaster::ray_clear`] without counting the ray in [`RayCaster::rays_cast`] (rays that
     /// analyse the scene rather than compute visibility).
     #[must_use]
     pub fn ray_clear_uncounted(&self, origin: DVec3, dir: DVec3) -> bool {
+        self.ray_clear_skipping_uncounted(origin, dir, crate::hierarchy::NONE)
+    }
+
+    /// [`RayCaster::ray_clear_skipping`] without counting the ray.
+    fn ray_clear_skipping_uncounted(&self, origin: DVec3, dir: DVec3, skip: u32) -> bool {
         if self.triangles.is_empty() {
             return true;
         }
         let ray = Ray::new(self.to_local(origin), ray_direction(dir), 0.0, f32::INFINITY);
-        self.bvh.ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
+        self.bvh
+            .ray_traverse_miss(ray, |ray, id| if self.tri_polygon[id] == skip { f32::INFINITY } else { self.triangles[id].intersect(ray) })
     }
 
     /// Kernel-weighted visibility between `source` and `receiver` against every triangle of the
