@@ -36,3 +36,33 @@ fn bench_shafts_rows_repeats_and_noise() {
     assert!(row("obb/shaft")["links"].as_u64() <= row("rays")["links"].as_u64());
     assert!(row("obb/shaft")["rays"].as_u64() < row("rays")["rays"].as_u64());
 }
+
+/// `radiosity bench canopy` end to end on a small canopy: one row per leaf count with the solve's
+/// figures, and the leaves' and ground's absorbed power within 1% of the photon tracer's (plus
+/// three of its standard errors) in each band.
+#[test]
+fn bench_canopy_rows_and_reference() {
+    let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["bench", "canopy", "--leaves", "60", "--photons", "1000000", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    assert_eq!(rows.len(), 1);
+    let r = &rows[0];
+    assert_eq!(r["leaves"], 60);
+    assert_eq!(r["finished"], true);
+    assert_eq!(r["target_met"], true, "{r}");
+    for key in ["time_s", "peak_rss_bytes", "links", "elements", "error_estimate", "trace_s"] {
+        assert!(r[key].as_f64().is_some_and(|v| v > 0.0), "{key}: {r}");
+    }
+    let bands = r["bands"].as_array().unwrap();
+    assert_eq!(bands.len(), 2);
+    for b in bands {
+        assert!((b["balance"].as_f64().unwrap() - 1.0).abs() <= 5e-3, "{b}");
+        for (solved, traced) in [("leaves_absorbed", "traced_leaves"), ("ground_absorbed", "traced_ground")] {
+            let (s, t, e) = (b[solved].as_f64().unwrap(), b[traced]["mean"].as_f64().unwrap(), b[traced]["std_error"].as_f64().unwrap());
+            assert!((s - t).abs() <= 0.01 * t + 3.0 * e, "{} {solved}: {s} against {t} ± {e}", b["band"]);
+        }
+    }
+}

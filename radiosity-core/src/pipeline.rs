@@ -485,7 +485,7 @@ pub fn run_with_points(
     let lights = scene.lights();
     let direct_caster = config.use_visibility.then_some(&caster);
     // Luminaires: surfaces split for their light, every element's direct illuminance.
-    crate::luminaire::prepare(&mut h, &lights, direct_caster);
+    crate::luminaire::prepare(&mut h, &lights, direct_caster, config.target_error.is_some());
     // Both sides of a transmitting leaf are cut into the same pieces (here and after every
     // refinement), so each piece passes its light through to the piece behind it.
     if !h.match_sides().is_empty() {

@@ -29,6 +29,10 @@ pub enum BenchCommand {
     /// the default target error: time, peak RSS, leaves, links, true error, estimate, power
     /// balance.
     Accuracy(super::bench_accuracy::AccuracyBenchArgs),
+    /// Canopies of transmitting leaves in two bands under the sun and a sky, at the default
+    /// settings, each in its own process: time, peak RSS, links, estimate, balance, and the
+    /// leaves' and ground's absorbed power against an independent photon tracer.
+    Canopy(super::bench_canopy::CanopyBenchArgs),
 }
 
 /// Arguments of `bench shafts`.
@@ -147,6 +151,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Instancing(args) => bench_instancing(&args),
         BenchCommand::Shafts(args) => bench_shafts(&args),
         BenchCommand::Accuracy(args) => super::bench_accuracy::run(&args),
+        BenchCommand::Canopy(args) => super::bench_canopy::run(&args),
     }
 }
 

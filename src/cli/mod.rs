@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_accuracy;
+mod bench_canopy;
 mod bench_reference;
 mod generate;
 #[cfg(feature = "mpi")]

@@ -98,6 +98,8 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         min_piece_rel: 0.25f64.powi(i32::from(config.min_polygon_depth)),
         direct: Vec::new(),
         direct_error: Vec::new(),
+        direct_soft: Vec::new(),
+        direct_edge: Vec::new(),
     };
     let centroids: Vec<DVec3> = h.elements.iter().map(|e| e.center).collect();
     h.root = build_cluster(&mut h, &centroids, 0, n, 0, config.max_leaf_polygons.max(2));

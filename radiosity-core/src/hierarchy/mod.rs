@@ -132,6 +132,15 @@ pub struct Hierarchy {
     /// quadrature (signed, per channel; zero where no shadow boundary crosses it): meaningful for
     /// leaves; filled with it.
     pub direct_error: Vec<[f64; 3]>,
+    /// Per element, the direct irradiance from the soft distant sources (the sky's cells) where
+    /// every point of its rule and its corners see each of them alike, which its pieces then take
+    /// instead of tracing it again (the same light, exact where the visibility is uniform); `None`
+    /// elsewhere. Filled with [`Hierarchy::direct`].
+    pub direct_soft: Vec<Option<[f64; 3]>>,
+    /// Per element, the step in direct irradiance across the shadow boundaries that cross it
+    /// (per channel; zero where none does): how much its direct light varies over it, which a
+    /// constant value per element does not show. Filled with [`Hierarchy::direct`].
+    pub direct_edge: Vec<[f64; 3]>,
 }
 
 impl Hierarchy {

@@ -4,7 +4,9 @@
 //! The variation over a leaf is measured at probe points (its centre and its corners pulled a
 //! little toward it, as [`crate::formfactor::estimate_max`] probes): the irradiance there is
 //! gathered from every link on the leaf's chain with the point form factor, and turned into
-//! radiosity (`E + ρH + t·H̄`). A parent's range is the union of its children's. A source whose
+//! radiosity (`E + ρH + t·H̄`), and widened by the step a shadow edge of the direct light makes
+//! where one crosses the leaf or its other side ([`crate::hierarchy::Hierarchy::direct_edge`]),
+//! which the probes may all miss. A parent's range is the union of its children's. A source whose
 //! radiosity does not vary (a lamp of uniform exitance, a furnace wall) needs no subdivision however
 //! much light it sends: what the receiver gets from it is exact with the link's form factor.
 
@@ -239,6 +241,13 @@ fn leaf_range(h: &Hierarchy, index: &LinksByReceiver<'_>, sol: &Solution, leaf: 
             lo[c] = lo[c].min(bx);
             hi[c] = hi[c].max(bx);
         }
+    }
+    // A shadow boundary across the leaf, or across its other side, steps its direct light, and
+    // its reflection and transmission with it, where the probes may not see it.
+    let edge = |x: ElementId| h.direct_edge.get(x as usize).copied().unwrap_or_default();
+    let (own, other) = (edge(leaf), if mate == NONE { [0.0; 3] } else { edge(mate) });
+    for c in 0..3 {
+        hi[c] = hi[c].max(lo[c] + rho[c] * own[c] + t[c] * other[c]);
     }
     (lo, hi)
 }
