@@ -364,6 +364,89 @@ fn generated_tree_under_daylight_reports_absorbed_par_and_nir() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A generated lamp-lit tree turned into a daylight scene by hand, as a user would: two bands
+/// with optics per band, a sun and a sky, the ground left in one piece, and the lamps kept with no
+/// emission (black, one-sided, their backs to the sky). The light landing on the lamps' backs
+/// (from the sun and sky, and from the tree and ground below) is blocked there: it is counted as
+/// lost at backs, the balance closes within [`HAND_WRITTEN_BALANCE_TOL`] with it in each band, and
+/// a warning names the share and the one-sided materials. Before (2026-12-06) the balance read
+/// 0.549 / 0.548 and the lost light was in no figure.
+#[test]
+fn a_hand_written_daylight_tree_balances_and_names_the_light_lost_at_backs() {
+    let dir = std::env::temp_dir().join(format!("radiosity-hand-daylight-{}", std::process::id()));
+    let bin = env!("CARGO_BIN_EXE_radiosity");
+    let run = |args: &[&str]| Command::new(bin).args(args).output().expect("the binary runs");
+    let tree = dir.join("tree");
+    let g = run(&["generate", "tree", "--age", "3", "-o", tree.to_str().unwrap()]);
+    assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
+    let path = tree.join("tree.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut edited = String::new();
+    let mut material = "";
+    for line in text.lines() {
+        if let Some(name) = line.strip_prefix("name = ") {
+            material = if name.contains("bark") {
+                "bark"
+            } else if name.contains("leaf") {
+                "leaf"
+            } else if name.contains("ground") {
+                "ground"
+            } else if name.contains("light") {
+                "light"
+            } else {
+                ""
+            };
+        }
+        let replaced = match (material, line.split(" = ").next()) {
+            ("bark", Some("reflectance")) => "reflectance = [0.15, 0.35]",
+            ("leaf", Some("reflectance")) => "reflectance = [0.10, 0.45]",
+            ("leaf", Some("transmittance")) => "transmittance = [0.05, 0.40]",
+            ("ground", Some("reflectance")) => "reflectance = [0.10, 0.25]",
+            ("light", Some("reflectance")) => "reflectance = [0.0, 0.0]",
+            ("light", Some("emission")) => "emission = [0.0, 0.0]",
+            _ => line,
+        };
+        edited.push_str(replaced);
+        edited.push('\n');
+        if line.starts_with("root = ") {
+            edited.push_str("bands = [\"PAR\", \"NIR\"]\n");
+        }
+    }
+    edited.push_str(
+        "\n[sun]\nlatitude = 43.61\nlongitude = 3.88\ntime = \"2026-06-21T12:00:00+02:00\"\ndirect_normal = [400.0, 380.0]\n\n\
+         [sky]\nmodel = \"cie-overcast\"\ndiffuse_horizontal = [100.0, 90.0]\ndirections = 145\n",
+    );
+    assert_eq!(edited.matches("[0.0, 0.0]").count(), 2, "the lamps made black and dark:\n{edited}");
+    std::fs::write(&path, edited).unwrap();
+    let out = dir.join("out");
+    let s = run(&["solve", path.to_str().unwrap(), "-o", out.to_str().unwrap(), "--no-image", "--quiet"]);
+    assert!(s.status.success(), "{}", String::from_utf8_lossy(&s.stderr));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    assert!(stats["local_solves"].as_u64().unwrap() > 1, "solved instanced");
+    for band in ["PAR", "NIR"] {
+        let p = &stats["power_by_band"][band];
+        let (incident, absorbed, escaped, lost) = (
+            p["incident"].as_f64().unwrap(),
+            p["absorbed"].as_f64().unwrap(),
+            p["escaped"].as_f64().unwrap(),
+            p["lost_at_backs"].as_f64().unwrap(),
+        );
+        // The lamps' backs take a good share of the sky (three 2 m squares over the tree).
+        assert!(lost > 0.1 * incident, "{band}: lost at backs {lost} of {incident}");
+        let balance = (absorbed + escaped + lost) / incident;
+        assert!((balance - 1.0).abs() <= HAND_WRITTEN_BALANCE_TOL, "{band}: balance {balance}");
+    }
+    let warnings = stats["solve_warnings"].as_array().expect("a warning");
+    assert!(
+        warnings.iter().any(|w| w.as_str().is_some_and(|w| w.contains("back of one-sided faces") && w.contains("`light`"))),
+        "{warnings:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// How closely a user's hand-written daylight scene balances in each band (issue: 0.5%).
+const HAND_WRITTEN_BALANCE_TOL: f64 = 5e-3;
+
 /// Where the instanced solve departs from the flattened one, by material and side (run by hand).
 #[test]
 #[ignore = "diagnostic"]

@@ -675,7 +675,7 @@ fn solve_instanced(
                     incident: b.incident[c],
                     absorbed: b.absorbed[c],
                     escaped: b.escaped[c],
-                    lost_at_backs: 0.0,
+                    lost_at_backs: b.lost_at_backs[c],
                 };
                 (n.clone(), serde_json::to_value(band).expect("plain numbers"))
             })
@@ -685,12 +685,19 @@ fn solve_instanced(
             incident: b.incident[c],
             absorbed: b.absorbed[c],
             escaped: b.escaped[c],
-            lost_at_backs: 0.0,
+            lost_at_backs: b.lost_at_backs[c],
         }));
         doc["power_emitted"] = serde_json::json!(combine(&b.emitted));
         doc["power_incident"] = serde_json::json!(combine(&b.incident));
         doc["power_escaped"] = serde_json::json!(combine(&b.escaped));
+        doc["power_lost_at_backs"] = serde_json::json!(combine(&b.lost_at_backs));
         doc["power_balance"] = serde_json::json!(total.balance(true));
+        if let Some(w) = instanced_lost_warning(scene, b, nb) {
+            if !args.quiet {
+                eprintln!("warning: {w}");
+            }
+            doc["solve_warnings"] = serde_json::json!([w]);
+        }
         doc["power_by_band"] = serde_json::Value::Object(by_band);
     }
     if bands.declared {
@@ -724,8 +731,9 @@ fn solve_instanced(
         );
         if let Some(b) = &balance {
             for (c, n) in written.bands.iter().enumerate() {
+                let lost = if b.lost_at_backs[c] > 0.0 { format!(", lost at backs {:.6e} W", b.lost_at_backs[c]) } else { String::new() };
                 println!(
-                    "{n}: incident {:.6e} W, absorbed {:.6e} W, escaped {:.6e} W, balance {}",
+                    "{n}: incident {:.6e} W, absorbed {:.6e} W, escaped {:.6e} W{lost}, balance {}",
                     b.incident[c],
                     b.absorbed[c],
                     b.escaped[c],
@@ -741,6 +749,29 @@ fn solve_instanced(
         println!("wrote {}/{{{files}}}", args.out.display());
     }
     Ok(())
+}
+
+/// The warning for light lost at the backs of one-sided faces in an instanced solve (as the plain
+/// solve's `radiosity::output::stats::lost_at_backs_warning`, with the one-sided materials named
+/// instead of the faces): above `LOST_AT_BACKS_WARN_REL` of the incident light in some of the
+/// `bands` channels.
+fn instanced_lost_warning(
+    scene: &radiosity::instancing::InstancedScene,
+    b: &radiosity::instancing::balance::PowerBalance,
+    bands: usize,
+) -> Option<String> {
+    let share = (0..bands.min(3)).filter(|&c| b.incident[c] > 0.0).map(|c| b.lost_at_backs[c] / b.incident[c]).fold(0.0, f64::max);
+    if share <= radiosity::output::LOST_AT_BACKS_WARN_REL {
+        return None;
+    }
+    let one_sided: Vec<String> =
+        scene.materials.iter().filter(|m| !m.two_sided && !m.is_emitter()).map(|m| format!("`{}`", m.name)).collect();
+    Some(format!(
+        "{}: {:.2}% of the incident light lands on the back of one-sided faces and is lost there (one-sided materials: {}): give their material `two_sided = true` for a back that reflects like the front, or leave them one-sided where the backs are really hidden",
+        scene.name,
+        100.0 * share,
+        one_sided.join(", ")
+    ))
 }
 
 /// Shows the share of flattened polygons finished while passing them on.

@@ -13,6 +13,11 @@
 //!   carry `B·A/N` of their leaf's radiosity out.
 //!   Seeded by the polygon's flattened index: the same figure whatever order polygons arrive in.
 //! - **Absorbed**: `A·(1 − ρ − t)·H` summed over the polygons (as `patches.csv` has it).
+//! - **Lost at backs**: what lands on the back of a one-sided face (its material not two-sided),
+//!   where the solve neither absorbs nor passes it on: the incident rays and the escape rays
+//!   whose first hit is such a back carry it there (a black lamp housing one-sided under the sky,
+//!   a ground seen from below). The balance counts it beside what is absorbed, and the solve
+//!   names it.
 //!
 //! Both estimates are Monte Carlo: their noise, not the solve, sets how closely the balance can be
 //! read (see `tests/instanced_daylight.rs` for what was measured).
@@ -52,6 +57,7 @@ pub struct DaylightBalance<S> {
     escaped: [f64; 3],
     absorbed: [f64; 3],
     emitted: [f64; 3],
+    lost: [f64; 3],
     /// Emission per material.
     emission: Vec<[f64; 3]>,
 }
@@ -71,15 +77,18 @@ pub struct PowerBalance {
     pub escaped: [f64; 3],
     /// Emitted by the polygons.
     pub emitted: [f64; 3],
+    /// Landing on the backs of one-sided faces, from the sources and from the surfaces, and lost
+    /// there.
+    pub lost_at_backs: [f64; 3],
 }
 
 impl PowerBalance {
-    /// `(absorbed + escaped) / (incident + emitted)` of channel `c` (`None` when nothing comes
-    /// in).
+    /// `(absorbed + escaped + lost at backs) / (incident + emitted)` of channel `c` (`None`
+    /// when nothing comes in).
     #[must_use]
     pub fn ratio(&self, c: usize) -> Option<f64> {
         let inp = self.incident[c] + self.emitted[c];
-        (inp > 0.0).then(|| (self.absorbed[c] + self.escaped[c]) / inp)
+        (inp > 0.0).then(|| (self.absorbed[c] + self.escaped[c] + self.lost_at_backs[c]) / inp)
     }
 }
 
@@ -99,6 +108,7 @@ impl<S: RadiositySink> DaylightBalance<S> {
             escaped: [0.0; 3],
             absorbed: [0.0; 3],
             emitted: [0.0; 3],
+            lost: [0.0; 3],
             emission: scene.materials.iter().map(|m| m.emission).collect(),
         }
     }
@@ -111,10 +121,11 @@ impl<S: RadiositySink> DaylightBalance<S> {
     fn flush(&mut self) {
         let diag = self.diagonal();
         let (Some(caster), batch) = (&self.caster, &self.batch) else { return };
-        let out: Vec<[f64; 3]> = batch.par_iter().map(|(index, leaves)| escaped(caster, *index, leaves, diag)).collect();
-        for e in out {
-            for (sum, v) in self.escaped.iter_mut().zip(e) {
-                *sum += v;
+        let out: Vec<([f64; 3], [f64; 3])> = batch.par_iter().map(|(index, leaves)| escaped(caster, *index, leaves, diag)).collect();
+        for (e, l) in out {
+            for c in 0..3 {
+                self.escaped[c] += e[c];
+                self.lost[c] += l[c];
             }
         }
         self.batch.clear();
@@ -125,21 +136,23 @@ impl<S: RadiositySink> DaylightBalance<S> {
     pub fn finish(mut self) -> (S, Option<PowerBalance>) {
         self.flush();
         let Some(caster) = &self.caster else { return (self.inner, None) };
-        let incident = incident(caster, &self.sources, &self.bounds);
-        (self.inner, Some(PowerBalance { incident, absorbed: self.absorbed, escaped: self.escaped, emitted: self.emitted }))
+        let (incident, lost) = incident(caster, &self.sources, &self.bounds);
+        let lost_at_backs = std::array::from_fn(|c| self.lost[c] + lost[c]);
+        (self.inner, Some(PowerBalance { incident, absorbed: self.absorbed, escaped: self.escaped, emitted: self.emitted, lost_at_backs }))
     }
 }
 
-/// The power leaving polygon `index` (leaves with their radiosity) for good.
-fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], diag: f64) -> [f64; 3] {
+/// The power leaving polygon `index` (leaves with their radiosity) for good, and what of it
+/// lands on the backs of one-sided faces.
+fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], diag: f64) -> ([f64; 3], [f64; 3]) {
     let areas: Vec<f64> = leaves.iter().map(|(p, _)| p.area()).collect();
     let total: f64 = areas.iter().sum();
     if total.is_nan() || total <= 0.0 || leaves.iter().all(|(_, b)| b.iter().all(|&v| v <= 0.0)) {
-        return [0.0; 3];
+        return ([0.0; 3], [0.0; 3]);
     }
     let mut rng = crate::visibility::Rng::for_link(0x0e5c_a9ed, (index >> 32) as u32, index as u32);
     let (offset, far) = (OFFSET_REL * diag.max(f64::MIN_POSITIVE), crate::daylight::FAR_REL * diag);
-    let mut out = [0.0; 3];
+    let (mut out, mut lost) = ([0.0; 3], [0.0; 3]);
     let reference = ESCAPE_AREA_REL * diag * diag;
     let rays = if reference > 0.0 {
         (f64::from(ESCAPE_RAYS) * total / reference).ceil().clamp(f64::from(ESCAPE_RAYS), f64::from(ESCAPE_MAX_RAYS)) as u32
@@ -160,23 +173,27 @@ fn escaped(caster: &InstanceCaster, index: u64, leaves: &[(Poly, [f64; 3])], dia
         let x = poly.sample(rng.next_f64(), rng.next_f64()) + n * offset;
         let (u1, u2) = (rng.next_f64(), rng.next_f64());
         let d = super::properties::cosine_dir_from(n, u1, u2);
-        if caster.segment_clear(x, x + d * far) {
-            for c in 0..3 {
-                out[c] += b[c] * step;
-            }
+        let to = match caster.first_hit(x, x + d * far) {
+            None => &mut out,
+            Some(true) => &mut lost,
+            Some(false) => continue,
+        };
+        for c in 0..3 {
+            to[c] += b[c] * step;
         }
     }
-    out
+    (out, lost)
 }
 
-/// The power the sources deliver to the surfaces (see the module docs).
-fn incident(caster: &InstanceCaster, sources: &[DistantSource], bounds: &Aabb) -> [f64; 3] {
+/// The power the sources deliver to the surfaces (see the module docs), and what of it lands on
+/// the backs of one-sided faces.
+fn incident(caster: &InstanceCaster, sources: &[DistantSource], bounds: &Aabb) -> ([f64; 3], [f64; 3]) {
     if bounds.is_empty() {
-        return [0.0; 3];
+        return ([0.0; 3], [0.0; 3]);
     }
     let diag = (bounds.max - bounds.min).length();
     let centre = (bounds.min + bounds.max) * 0.5;
-    let per_source: Vec<[f64; 3]> = sources
+    let per_source: Vec<([f64; 3], [f64; 3])> = sources
         .par_iter()
         .enumerate()
         .map(|(k, s)| {
@@ -191,22 +208,25 @@ fn incident(caster: &InstanceCaster, sources: &[DistantSource], bounds: &Aabb) -
             let g = INCIDENT_GRID;
             let (du, dv) = ((u1 - u0) / f64::from(g), (v1 - v0) / f64::from(g));
             let mut rng = crate::visibility::Rng::for_link(0x01c1_de47, k as u32, g);
-            let mut hits = 0u64;
+            let (mut hits, mut backs) = (0u64, 0u64);
             for i in 0..g {
                 for j in 0..g {
                     let u = u0 + (f64::from(i) + rng.next_f64()) * du;
                     let v = v0 + (f64::from(j) + rng.next_f64()) * dv;
                     let p = centre + e1 * u + e2 * v;
-                    if !caster.segment_clear(p + d * diag, p - d * diag) {
+                    if let Some(back) = caster.first_hit(p + d * diag, p - d * diag) {
                         hits += 1;
+                        backs += u64::from(back);
                     }
                 }
             }
-            let area = hits as f64 * du * dv;
-            s.irradiance.map(|e| e * area)
+            let cell = du * dv;
+            (s.irradiance.map(|e| e * hits as f64 * cell), s.irradiance.map(|e| e * backs as f64 * cell))
         })
         .collect();
-    per_source.iter().fold([0.0; 3], |a, b| std::array::from_fn(|c| a[c] + b[c]))
+    per_source
+        .iter()
+        .fold(([0.0; 3], [0.0; 3]), |(a, l), (b, m)| (std::array::from_fn(|c| a[c] + b[c]), std::array::from_fn(|c| l[c] + m[c])))
 }
 
 impl<S: RadiositySink> RadiositySink for DaylightBalance<S> {

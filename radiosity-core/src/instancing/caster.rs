@@ -21,7 +21,11 @@ use obvhs::{Boundable, BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh
 /// A primitive of a prototype's BVH: one of its triangles, or one of its instances.
 #[derive(Clone, Copy, Debug)]
 enum Primitive {
-    Triangle(Triangle),
+    Triangle {
+        triangle: Triangle,
+        /// Its material is one-sided: light reaching its back is blocked there and lost.
+        one_sided: bool,
+    },
     Instance {
         prototype: PrototypeId,
         /// Prototype-local coordinates of the parent → those of the instance's prototype.
@@ -34,7 +38,7 @@ enum Primitive {
 impl Boundable for Primitive {
     fn aabb(&self) -> obvhs::aabb::Aabb {
         match self {
-            Primitive::Triangle(t) => t.aabb(),
+            Primitive::Triangle { triangle, .. } => triangle.aabb(),
             Primitive::Instance { bounds, .. } => *bounds,
         }
     }
@@ -80,7 +84,8 @@ impl InstanceCaster {
                     for k in 1..v.len() - 1 {
                         let t = Triangle { v0: frame(v[0]), v1: frame(v[k]), v2: frame(v[k + 1]) };
                         if (t.v1 - t.v0).cross(t.v2 - t.v0).length_squared() > 0.0 {
-                            primitives.push(Primitive::Triangle(t));
+                            let one_sided = !scene.materials.get(q.material as usize).is_some_and(|m| m.two_sided);
+                            primitives.push(Primitive::Triangle { triangle: t, one_sided });
                         }
                     }
                 }
@@ -129,6 +134,60 @@ impl InstanceCaster {
         self.clear_in(self.root, a, b)
     }
 
+    /// The nearest polygon the segment `a`–`b` (scene coordinates, without its end fractions
+    /// [`SEGMENT_END_EPS`]) meets: `Some(true)` where that is the back of a one-sided face (its
+    /// material not two-sided), where light is blocked and lost; `Some(false)` for any other
+    /// polygon; `None` when it meets none.
+    #[must_use]
+    pub fn first_hit(&self, a: DVec3, b: DVec3) -> Option<bool> {
+        self.first_in(self.root, a, b).map(|(_, back)| back)
+    }
+
+    /// [`Self::first_hit`] in the frame of `prototype`, with the hit's place as a fraction of the
+    /// segment (which an affine map keeps). A transform keeps each face's front (a mirror reverses
+    /// its vertices, [`super::model::Transform::poly`]), so the side is read in the local frame.
+    fn first_in(&self, prototype: PrototypeId, a: DVec3, b: DVec3) -> Option<(f64, bool)> {
+        let p = self.prototypes[prototype as usize].as_ref()?;
+        let (la, lb) = (p.frame.point(a), p.frame.point(b));
+        let d = lb - la;
+        let len = d.length();
+        if !len.is_finite() || len <= 0.0 {
+            return None;
+        }
+        let dir = d / len;
+        let eps = SEGMENT_END_EPS;
+        let ray = Ray::new(la, dir, len * eps, len * (1.0 - eps));
+        let mut hit = obvhs::ray::RayHit::none();
+        let back = std::cell::Cell::new(false);
+        let found = p.bvh.ray_traverse(ray, &mut hit, |ray, id| match &p.primitives[id] {
+            Primitive::Triangle { triangle: t, one_sided } => {
+                let x = t.intersect(ray);
+                if x >= ray.tmin && x < ray.tmax {
+                    back.set(*one_sided && (t.v1 - t.v0).cross(t.v2 - t.v0).dot(dir) > 0.0);
+                }
+                x
+            }
+            Primitive::Instance { prototype, to_child, bounds } => {
+                if bounds.intersect_ray(ray) > ray.tmax {
+                    return f32::INFINITY;
+                }
+                match self.first_in(*prototype, to_child.transform_point3(a), to_child.transform_point3(b)) {
+                    Some((s, is_back)) => {
+                        let x = (s * f64::from(len)) as f32;
+                        if x >= ray.tmin && x < ray.tmax {
+                            back.set(is_back);
+                            x
+                        } else {
+                            f32::INFINITY
+                        }
+                    }
+                    None => f32::INFINITY,
+                }
+            }
+        });
+        found.then(|| (f64::from(hit.t) / f64::from(len), back.get()))
+    }
+
     /// [`Self::segment_clear`] in the frame of `prototype` (its local coordinates).
     fn clear_in(&self, prototype: PrototypeId, a: DVec3, b: DVec3) -> bool {
         let Some(p) = &self.prototypes[prototype as usize] else { return true };
@@ -142,7 +201,7 @@ impl InstanceCaster {
         let eps = SEGMENT_END_EPS;
         let ray = Ray::new(la, d / len, len * eps, len * (1.0 - eps));
         p.bvh.ray_traverse_miss(ray, |ray, id| match &p.primitives[id] {
-            Primitive::Triangle(t) => t.intersect(ray),
+            Primitive::Triangle { triangle, .. } => triangle.intersect(ray),
             Primitive::Instance { prototype, to_child, bounds } => {
                 if bounds.intersect_ray(ray) > ray.tmax {
                     return f32::INFINITY;

@@ -31,7 +31,7 @@ pub use ply::write_ply;
 pub use points::{write_points_csv, write_points_csv_in};
 pub use render::{Frame, OUTSIDE_PREFERENCE, RenderConfig, ToneMap, default_view, frame, mean_brightness, render, render_frame, write_png};
 pub use smooth::CornerValues;
-pub use stats::{BandPower, Stats, StatsTimes, channel_powers, peak_rss_bytes, power_balance};
+pub use stats::{BandPower, LOST_AT_BACKS_WARN_REL, Stats, StatsTimes, channel_powers, peak_rss_bytes, power_balance};
 pub use view::{
     Candidate, INSIDE_CORNER_FRACTION, INSIDE_FOV_DEG, MAX_VIEW_ANGLE_DEG, OUTSIDE_ELEVATION_DEG, OUTSIDE_FOV_DEG, OUTSIDE_MARGIN, View,
     ViewError, ViewSpec, candidate_views, up_axis,
