@@ -152,8 +152,8 @@ fn needs_split(
 }
 
 /// Whether some polygon casts a shadow along `toward` (a distant source's direction of travel) on
-/// part of surface element `id` smaller than the element: one that its quadrature points may all
-/// miss (a 1 m² leaf's shadow on a 100 m² ground fell between the 9 points of the ground's rule,
+/// part of surface element `id` smaller than the element (in size or in area: a sliver cast by a
+/// leaf seen edge-on): one that its quadrature points may all miss (a 1 m² leaf's shadow on a 100 m² ground fell between the 9 points of the ground's rule,
 /// which then got the sun as if nothing stood over it). Found through `occluders` (a box
 /// hierarchy over the input polygons, see [`polygon_boxes`]) with the shaft the element's box
 /// sweeps toward the source, then exactly: the candidate's part in front of the element's plane,
@@ -200,7 +200,11 @@ fn smaller_shadow_falls_on(h: &Hierarchy, id: u32, toward: DVec3, occluders: &cr
             let shadow: Vec<DVec3> = front.iter().map(|&v| v - toward * (n.dot(v - x0) / dn)).collect();
             let centre = shadow.iter().copied().sum::<DVec3>() / shadow.len() as f64;
             let radius = shadow.iter().map(|&v| (v - centre).length()).fold(0.0, f64::max);
-            if radius >= e.radius {
+            // Small, or thin: a leaf seen edge-on casts a sliver longer than the element and
+            // narrower than its points' spacing.
+            let area =
+                0.5 * (1..shadow.len() - 1).map(|k| (shadow[k] - shadow[0]).cross(shadow[k + 1] - shadow[0]).dot(n).abs()).sum::<f64>();
+            if radius >= e.radius && area >= e.area {
                 return;
             }
             found.set(convex_overlap(own, &shadow, n));

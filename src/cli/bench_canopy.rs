@@ -42,6 +42,10 @@ pub struct CanopyBenchArgs {
     /// Print one JSON document instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// An option passed on to every `radiosity solve` (repeatable), e.g.
+    /// `--solve-arg=--target-error=0.005`.
+    #[arg(long = "solve-arg", value_name = "ARG", allow_hyphen_values = true)]
+    pub solve_args: Vec<String>,
 }
 
 /// The bands, and the optics and light in each.
@@ -101,7 +105,7 @@ pub fn run(args: &CanopyBenchArgs) -> anyhow::Result<()> {
         if !args.json {
             eprintln!("canopy of {n} leaves: solving ...");
         }
-        let mut row = solve(&exe, &dir, args.timeout)?;
+        let mut row = solve(&exe, &dir, args.timeout, &args.solve_args)?;
         row.leaves = n;
         row.lai = n as f64 * 0.01 / (2.0 * HALF).powi(2);
         if args.photons > 0 {
@@ -189,13 +193,14 @@ fn write_canopy(n: usize, seed: u64, dir: &Path) -> anyhow::Result<Vec<[[f64; 3]
     Ok(c.leaves.iter().map(|l| l.map(|v| v.to_array())).collect())
 }
 
-/// Solves `dir/canopy.toml` in a child process (stopped after `timeout` seconds) and reads its
-/// figures.
-fn solve(exe: &Path, dir: &Path, timeout: f64) -> anyhow::Result<Row> {
+/// Solves `dir/canopy.toml` in a child process (with the `extra` options; stopped after
+/// `timeout` seconds) and reads its figures.
+fn solve(exe: &Path, dir: &Path, timeout: f64, extra: &[String]) -> anyhow::Result<Row> {
     let out = dir.join("out");
     let mut child = Command::new(exe)
         .args(["solve", "canopy.toml", "--quiet", "--no-image", "--out"])
         .arg(&out)
+        .args(extra)
         .current_dir(dir)
         .spawn()
         .with_context(|| format!("running {}", exe.display()))?;
