@@ -21,7 +21,7 @@
 //! nearer than the angular size allows), the leaf is sampled on its quarters as well and the
 //! difference is its quadrature error ([`update_direct`], [`Hierarchy::direct_error`]); each
 //! polygon's share ([`direct_polygon_errors`]) is in the solve's error estimate, and under a target
-//! error the levels split those leaves (or sample them finer, at the smallest element size) until
+//! error the levels sample those leaves finer (then split them) until
 //! every polygon's mean direct light is within a share of the target of its own value
 //! ([`direct_splits`], [`deepen_direct`]).
 
