@@ -158,6 +158,11 @@ pub struct LinkCtx<'a> {
 /// the ones an oracle decided on.
 pub const FRESH_VISIBILITY_SALT: u64 = 0x5851_F42D_4C95_7F2D;
 
+/// How many times [`LinkCtx::surfaces_cross`] has two crossing leaves quartered at least (both
+/// pieces less deep than this below their polygons); below that the oracle's own criteria
+/// decide.
+pub const CROSSING_SPLIT_DEPTH: u16 = 2;
+
 impl<'a> LinkCtx<'a> {
     /// A fresh context.
     #[must_use]
@@ -352,17 +357,29 @@ impl<'a> LinkCtx<'a> {
     /// has no scale, and a link between them shares its transfer out over their pieces by the
     /// shape of its form factor alone: two crossing 10 cm leaves linked whole absorbed 1.1% less
     /// NIR than an independent photon tracer finds, an error no coarsening of the mesh shows.
+    /// Only while both are less deep than [`CROSSING_SPLIT_DEPTH`] below their polygons: past
+    /// that the oracle's own criteria subdivide the pieces along the line. Quartered once each, the
+    /// two leaves absorb what they absorb split down to 1/4096 (to five digits), and a 3,200-leaf
+    /// canopy's first level made 26 k leaves and 586 k links instead of 45 k and 710 k.
     #[must_use]
     pub fn surfaces_cross(&self) -> bool {
         let (s, r) = (self.emitter_element(), self.receiver_element());
         !s.is_cluster()
             && !r.is_cluster()
             && (s.center - r.center).length() < formfactor::NEAR_SEPARATION * (s.radius + r.radius)
+            && self.below_polygon(s) < CROSSING_SPLIT_DEPTH
+            && self.below_polygon(r) < CROSSING_SPLIT_DEPTH
             && formfactor::surfaces_cross(s, r)
     }
 
+    /// How many times surface element `e` is quartered below its polygon (0 for a cluster).
+    fn below_polygon(&self, e: &Element) -> u16 {
+        let h = self.services.hierarchy;
+        e.polygon().map_or(0, |p| e.depth.saturating_sub(h.get(p).depth))
+    }
+
     /// Too near for a link: [`LinkCtx::clusters_too_near`] or [`LinkCtx::surfaces_cross`]; the
-    /// pair is subdivided while it can be.
+    /// pair is subdivided.
     #[must_use]
     pub fn too_near(&self) -> bool {
         self.clusters_too_near() || self.surfaces_cross()
