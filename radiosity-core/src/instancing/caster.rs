@@ -52,6 +52,21 @@ struct PrototypeBvh {
     frame: BvhFrame,
 }
 
+impl PrototypeBvh {
+    /// The segment `a`–`b` (the prototype's local coordinates) as a ray in the BVH's frame without
+    /// its end fractions [`SEGMENT_END_EPS`], and its length there; `None` for a zero-length or
+    /// non-finite segment, which meets nothing.
+    fn segment_ray(&self, a: DVec3, b: DVec3) -> Option<(Ray, f32)> {
+        let (la, lb) = (self.frame.point(a), self.frame.point(b));
+        let d = lb - la;
+        let len = d.length();
+        if !len.is_finite() || len <= 0.0 {
+            return None;
+        }
+        Some((Ray::new(la, d / len, len * SEGMENT_END_EPS, len * (1.0 - SEGMENT_END_EPS)), len))
+    }
+}
+
 /// Segment tests against an instanced scene through its nested per-prototype BVHs. Casts are not
 /// counted: a shared counter's cache-line traffic cost 15% of an instanced tree solve on two
 /// threads.
@@ -148,15 +163,8 @@ impl InstanceCaster {
     /// its vertices, [`super::model::Transform::poly`]), so the side is read in the local frame.
     fn first_in(&self, prototype: PrototypeId, a: DVec3, b: DVec3) -> Option<(f64, bool)> {
         let p = self.prototypes[prototype as usize].as_ref()?;
-        let (la, lb) = (p.frame.point(a), p.frame.point(b));
-        let d = lb - la;
-        let len = d.length();
-        if !len.is_finite() || len <= 0.0 {
-            return None;
-        }
-        let dir = d / len;
-        let eps = SEGMENT_END_EPS;
-        let ray = Ray::new(la, dir, len * eps, len * (1.0 - eps));
+        let (ray, len) = p.segment_ray(a, b)?;
+        let dir = ray.direction;
         let mut hit = obvhs::ray::RayHit::none();
         let back = std::cell::Cell::new(false);
         let found = p.bvh.ray_traverse(ray, &mut hit, |ray, id| match &p.primitives[id] {
@@ -191,15 +199,7 @@ impl InstanceCaster {
     /// [`Self::segment_clear`] in the frame of `prototype` (its local coordinates).
     fn clear_in(&self, prototype: PrototypeId, a: DVec3, b: DVec3) -> bool {
         let Some(p) = &self.prototypes[prototype as usize] else { return true };
-        let (la, lb) = (p.frame.point(a), p.frame.point(b));
-        let d = lb - la;
-        let len = d.length();
-        // A zero-length or non-finite segment meets nothing.
-        if !len.is_finite() || len <= 0.0 {
-            return true;
-        }
-        let eps = SEGMENT_END_EPS;
-        let ray = Ray::new(la, d / len, len * eps, len * (1.0 - eps));
+        let Some((ray, _)) = p.segment_ray(a, b) else { return true };
         p.bvh.ray_traverse_miss(ray, |ray, id| match &p.primitives[id] {
             Primitive::Triangle { triangle, .. } => triangle.intersect(ray),
             Primitive::Instance { prototype, to_child, bounds } => {
