@@ -138,6 +138,29 @@ pub const MAX_SOURCE_KERNEL_VARIATION: f64 = 2.0;
 /// near for the isotropic cluster approximation (the criterion of the BF oracle).
 pub const CLUSTER_NEAR_FACTOR: f64 = 2.0;
 
+/// How unevenly `receiver`, as a whole, weights the surface of `source`: the spread
+/// `(max − min) / mean` of the point form factor from the source's probe points (centre, corners
+/// pulled in by [`formfactor::MAX_PROBE_PULL`]) to the receiver, at most
+/// [`MAX_SOURCE_KERNEL_VARIATION`] (and that for a cluster source, whose members' weights are not
+/// probed, or one the receiver does not see). Near 0 for a far receiver, large for one touching
+/// the source: a radiosity varying by `ΔB` over the source moves the receiver's mean irradiance by
+/// at most `F · κ · ΔB / 4` (the covariance of kernel and radiosity, each within its range).
+#[must_use]
+pub fn source_kernel_spread(h: &Hierarchy, source: u32, receiver: u32) -> f64 {
+    let s = h.get(source);
+    let Some(sp) = s.poly() else { return MAX_SOURCE_KERNEL_VARIATION };
+    let (mut lo, mut hi, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
+    let vs = sp.vertices();
+    for x in std::iter::once(s.center).chain(vs.iter().map(|&v| v + formfactor::MAX_PROBE_PULL * (s.center - v))) {
+        let f = formfactor::point_to_element(h, x, s.normal, receiver);
+        lo = lo.min(f);
+        hi = hi.max(f);
+        sum += f;
+    }
+    let mean = sum / (vs.len() + 1) as f64;
+    if mean > 0.0 { ((hi - lo) / mean).min(MAX_SOURCE_KERNEL_VARIATION) } else { MAX_SOURCE_KERNEL_VARIATION }
+}
+
 /// Everything an oracle sees of one link.
 pub struct LinkCtx<'a> {
     /// Shared services.
@@ -427,23 +450,7 @@ impl<'a> LinkCtx<'a> {
         if let Some(w) = self.data.source_variation_weight {
             return w;
         }
-        let h = self.services.hierarchy;
-        let s = self.emitter_element();
-        let kappa = match s.poly() {
-            None => MAX_SOURCE_KERNEL_VARIATION,
-            Some(sp) => {
-                let (mut lo, mut hi, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
-                let vs = sp.vertices();
-                for x in std::iter::once(s.center).chain(vs.iter().map(|&v| v + formfactor::MAX_PROBE_PULL * (s.center - v))) {
-                    let f = formfactor::point_to_element(h, x, s.normal, self.receiver);
-                    lo = lo.min(f);
-                    hi = hi.max(f);
-                    sum += f;
-                }
-                let mean = sum / (vs.len() + 1) as f64;
-                if mean > 0.0 { ((hi - lo) / mean).min(MAX_SOURCE_KERNEL_VARIATION) } else { MAX_SOURCE_KERNEL_VARIATION }
-            }
-        };
+        let kappa = source_kernel_spread(self.services.hierarchy, self.emitter, self.receiver);
         let w = self.form_factor(FormFactorQuality::Precise) * kappa;
         self.data.source_variation_weight = Some(w);
         w

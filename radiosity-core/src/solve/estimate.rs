@@ -306,9 +306,15 @@ pub fn largest_non_emitting_mean(h: &crate::hierarchy::Hierarchy, radiosity: &[[
 /// its range, times the reflectance, is how far its radiosity departs from its mean, and each link
 /// it sends passes that on to its receiver's mean with the link's form factor (the receiver's
 /// share of its polygon's area; every polygon of a receiving cluster whole), times the
-/// receiver's reflectance. A uniform field (a furnace) gives 0.
+/// receiver's reflectance, and times half the spread `κ` of the kernel over the source seen
+/// from the receiver ([`crate::refine::source_kernel_spread`]; whole for a link partly occluded,
+/// whose kernel steps where the occluder's shadow ends): what departs from the mean reaches the
+/// receiver only as far as the receiver weights the source unevenly (the covariance of radiosity
+/// and kernel, each within its range, is at most the product of their half ranges), so that a
+/// leaf's uneven light reaches the far ones of a canopy as a tenth of it. Per polygon and channel,
+/// in W/m² of radiosity. A uniform field (a furnace) gives 0.
 #[must_use]
-pub fn unresolved_polygons(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> f64 {
+pub fn unresolved_per_polygon(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
     use rayon::prelude::*;
     let n = h.n_polygons as usize;
     let by_receiver = super::leaf::LinksByReceiver::new(h, links);
@@ -343,20 +349,193 @@ pub fn unresolved_polygons(h: &crate::hierarchy::Hierarchy, links: &[crate::refi
             std::array::from_fn(|c| 0.5 * h.reflectance[p][c] * (hi[c] - lo[c]).max(0.0))
         })
         .collect();
+    // Each link from a whole polygon with its share of the spread (κ / 2, at most 1).
+    let weights: Vec<f64> = links
+        .par_iter()
+        .map(|l| {
+            let whole = h.get(l.source).polygon().is_some_and(|p| l.source == p && spread[p as usize] != [0.0; 3]);
+            if !whole {
+                0.0
+            } else if l.vis < 1.0 {
+                1.0
+            } else {
+                0.5 * crate::refine::source_kernel_spread(h, l.source, l.receiver)
+            }
+        })
+        .collect();
     let mut err = vec![[0.0; 3]; n];
-    for l in links {
-        let Some(p) = h.get(l.source).polygon().filter(|&p| l.source == p) else {
-            continue;
-        };
-        let s = spread[p as usize];
-        if s == [0.0; 3] {
+    for (l, &w) in links.iter().zip(&weights) {
+        if w == 0.0 {
             continue;
         }
+        let s = spread[l.source as usize];
         receiver_polygons(h, l.receiver, |q, share| {
             for c in 0..3 {
-                err[q][c] += h.reflectance[q][c] * share * l.ff * l.vis * s[c];
+                err[q][c] += h.reflectance[q][c] * share * l.ff * l.vis * w * s[c];
             }
         });
     }
+    err
+}
+
+/// The largest of [`unresolved_per_polygon`] over the measured polygons, relative to the largest
+/// non-emitting mean of `radiosity`.
+#[must_use]
+pub fn unresolved_polygons(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> f64 {
+    let err = unresolved_per_polygon(h, links, radiosity);
     worst_relative(h, radiosity, |q, c| err[q][c])
+}
+
+/// The mesh's and the direct light's error in the polygons' means, each polygon's own terms added
+/// before the largest is taken (a polygon's error is at most the sum of its own, and the largest
+/// of each term may lie on a different polygon): per measured polygon and channel, the Richardson
+/// error of its mean radiosity ([`richardson_estimate`], from `means`: fine, coarse, coarser),
+/// plus what polygons left whole put into it (`unresolved`, [`unresolved_per_polygon`]), plus its
+/// reflectance times its direct light's quadrature error (`direct`, per polygon and channel, or
+/// empty), relative to the largest measured mean; and with `irradiance_means` (the same three for
+/// the mean irradiance, direct light included) the Richardson error of the mean irradiance plus
+/// the direct light's error, relative to the largest mean irradiance. The larger of the two.
+#[must_use]
+pub fn mesh_and_direct_estimate(
+    h: &crate::hierarchy::Hierarchy,
+    means: [&[[f64; 3]]; 3],
+    irradiance_means: Option<[&[[f64; 3]]; 3]>,
+    unresolved: &[[f64; 3]],
+    direct: &[[f64; 3]],
+) -> f64 {
+    let direct_at = |p: usize, c: usize| direct.get(p).map_or(0.0, |d| d[c]);
+    let relative = |m: [&[[f64; 3]]; 3], own: &dyn Fn(usize, usize) -> f64| {
+        let (mut top, mut worst) = (0.0f64, 0.0f64);
+        for p in measured_polygons(h) {
+            for c in 0..3 {
+                top = top.max(m[0][p][c]);
+                worst = worst.max(richardson_error(m[0][p][c], m[1][p][c], m[2][p][c]) + own(p, c));
+            }
+        }
+        if top > 0.0 { worst / top } else { 0.0 }
+    };
+    let of_radiosity = relative(means, &|p, c| unresolved.get(p).map_or(0.0, |u| u[c]) + h.reflectance[p][c] * direct_at(p, c));
+    let of_irradiance = irradiance_means.map_or(0.0, |m| relative(m, &|p, c| direct_at(p, c)));
+    of_radiosity.max(of_irradiance)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{DVec3, Poly};
+    use crate::refine::Link;
+    use crate::scene::{Material, Polygon, Scene};
+
+    fn square(x0: f64, y0: f64, z: f64, side: f64, up: bool) -> Poly {
+        let (a, b, c, d) =
+            (DVec3::new(x0, y0, z), DVec3::new(x0 + side, y0, z), DVec3::new(x0 + side, y0 + side, z), DVec3::new(x0, y0 + side, z));
+        if up { Poly::quad(a, b, c, d) } else { Poly::quad(a, d, c, b) }
+    }
+
+    fn hierarchy(polys: &[(Poly, u32)], materials: Vec<Material>) -> crate::hierarchy::Hierarchy {
+        let scene = Scene {
+            name: "t".into(),
+            polygons: polys.iter().map(|&(poly, material)| Polygon { poly, material, group: 0 }).collect(),
+            materials,
+            groups: vec!["g".into()],
+            camera: None,
+            warnings: Default::default(),
+            luminaires: Vec::new(),
+            distant: Vec::new(),
+            units: Default::default(),
+        };
+        crate::hierarchy::build(&scene, &crate::hierarchy::BuildConfig::default())
+    }
+
+    /// A polygon's error is at most the sum of its own terms: the largest Richardson error on one
+    /// polygon and the largest direct-light error on another are not added.
+    #[test]
+    fn each_polygons_own_terms_are_added_before_the_largest_is_taken() {
+        let grey = Material::diffuse("grey", [0.5; 3]);
+        let h = hierarchy(&[(square(0.0, 0.0, 0.0, 1.0, true), 0), (square(2.0, 0.0, 0.0, 1.0, true), 0)], vec![grey]);
+        // Polygon 0: changes 0.3 then 1.2 (order 2): 0.1 still in its mean of 10. Polygon 1: no
+        // change, a direct-light error of 0.4 reflected at 0.5.
+        let fine = [[10.0; 3], [8.0; 3]];
+        let coarse = [[9.7; 3], [8.0; 3]];
+        let coarser = [[8.5; 3], [8.0; 3]];
+        let direct = [[0.0; 3], [0.4; 3]];
+        let none = [[0.0; 3]; 2];
+        let e = mesh_and_direct_estimate(&h, [&fine, &coarse, &coarser], None, &none, &direct);
+        assert!((e - 0.02).abs() < 1e-12, "largest own sum 0.2 of the top mean 10: {e}");
+        // With the irradiance means too: polygon 1's direct error of 0.4 against a top of 20.
+        let h_fine = [[20.0; 3], [5.0; 3]];
+        let e = mesh_and_direct_estimate(&h, [&fine, &coarse, &coarser], Some([&h_fine, &h_fine, &h_fine]), &none, &direct);
+        assert!((e - 0.02).abs() < 1e-12, "the radiosity side's 0.02 is the larger: {e}");
+    }
+
+    /// What a whole polygon's uneven radiosity puts into a receiver's mean: the bound covers the
+    /// exact covariance (quadrature over both polygons) for a receiver near it and one far away,
+    /// and the far one's bound is a small part of the first-order bound `ρ F ΔB / 2`.
+    #[test]
+    fn a_whole_polygons_uneven_light_reaches_far_receivers_as_the_kernel_varies() {
+        let lamp = Material { emission: [100.0; 3], ..Material::diffuse("lamp", [0.0; 3]) };
+        let grey = Material::diffuse("grey", [0.5; 3]);
+        // A small lamp over one corner of a unit floor; ceilings near and far above it.
+        let polys = [
+            (square(0.05, 0.05, 0.3, 0.1, false), 0),
+            (square(0.0, 0.0, 0.0, 1.0, true), 1),
+            (square(0.0, 0.0, 0.5, 1.0, false), 1),
+            (square(-2.0, -2.0, 10.0, 5.0, false), 1),
+        ];
+        let h = hierarchy(&polys, vec![lamp, grey]);
+        assert!(h.get(0).normal.z < 0.0 && h.get(1).normal.z > 0.0 && h.get(2).normal.z < 0.0);
+        let (lamp_b, rho) = (100.0, 0.5);
+        // The floor's radiosity at a point: the lamp's light there, reflected.
+        let floor_b = |x: DVec3| rho * lamp_b * crate::formfactor::point_to_element(&h, x, DVec3::Z, 0);
+        let n = 40;
+        let grid = |p: &Poly| -> Vec<DVec3> {
+            (0..n * n).map(|k| p.sample((f64::from(k % n) + 0.5) / f64::from(n), (f64::from(k / n) + 0.5) / f64::from(n))).collect()
+        };
+        let floor_points = grid(&polys[1].0);
+        let floor_mean = floor_points.iter().map(|&y| floor_b(y)).sum::<f64>() / floor_points.len() as f64;
+        // Links: lamp to floor; floor to each ceiling, with its form factor by quadrature.
+        let kernel = |x: DVec3, nx: DVec3, y: DVec3, ny: DVec3| {
+            let d = y - x;
+            let r2 = d.length_squared();
+            (nx.dot(d).max(0.0) * (-ny.dot(d)).max(0.0)) / (std::f64::consts::PI * r2 * r2)
+        };
+        let mut links = vec![Link { source: 0, receiver: 1, ff: 0.0, vis: 1.0 }];
+        let mut exact = Vec::new();
+        for r in [2u32, 3] {
+            let (rp, rn) = (polys[r as usize].0, h.get(r).normal);
+            let (mut ff, mut err) = (0.0, 0.0);
+            let receiver_points = grid(&rp);
+            let floor_area = 1.0 / floor_points.len() as f64;
+            for &x in &receiver_points {
+                for &y in &floor_points {
+                    let k = kernel(x, rn, y, DVec3::Z) * floor_area;
+                    ff += k;
+                    err += k * (floor_b(y) - floor_mean);
+                }
+            }
+            let m = receiver_points.len() as f64;
+            links.push(Link { source: 1, receiver: r, ff: ff / m, vis: 1.0 });
+            exact.push(rho * (err / m).abs());
+        }
+        let mut radiosity = vec![[0.0; 3]; h.len()];
+        radiosity[0] = [lamp_b; 3];
+        radiosity[1] = [floor_mean; 3];
+        let bound = unresolved_per_polygon(&h, &links, &radiosity);
+        // The first-order bound: ρ_R F times half the floor's range as the estimate samples it.
+        let spread = {
+            let e = h.get(1);
+            let pts: Vec<DVec3> = std::iter::once(e.center).chain(polys[1].0.vertices().iter().map(|&v| 0.5 * (v + e.center))).collect();
+            let vals: Vec<f64> = pts.iter().map(|&x| floor_b(x)).collect();
+            0.5 * (vals.iter().copied().fold(f64::MIN, f64::max) - vals.iter().copied().fold(f64::MAX, f64::min))
+        };
+        for (k, r) in [2usize, 3].into_iter().enumerate() {
+            let b = bound[r][0];
+            assert!(b >= exact[k], "receiver {r}: bound {b:.4e} below the exact {:.4e}", exact[k]);
+            let first_order = rho * links[k + 1].ff * spread;
+            assert!(b <= first_order * (1.0 + 1e-12), "receiver {r}: {b:.4e} over the first-order {first_order:.4e}");
+            if r == 3 {
+                assert!(b < 0.25 * first_order, "the far receiver's bound {b:.4e} is a small part of {first_order:.4e}");
+            }
+        }
+    }
 }
