@@ -117,9 +117,12 @@ fn a_memory_budget_that_misses_the_target_says_so_and_fails() {
 /// A lamp sealed in a closed box (its faces one-sided, outward) beside a grey ground under sun and
 /// sky: the lamp's light lands on the box's inner backs, which no link reaches and no one can
 /// see, so the power balance misses by about 1% and refinement does not move it (the links'
-/// light is right, the gap is outside them). The levels stop within three, with a warning that
-/// names the gap, instead of running ten levels of nothing. (This test's scene was once black
-/// one-sided leaves, whose lost backs are now counted: `tests/two_sided.rs`.)
+/// light is right, the gap is outside them). The levels stop as soon as the estimate meets the
+/// target and the gap has not moved (at most one level after the estimate first met it), with a
+/// warning that names the gap, instead of running ten levels of nothing. (This test's scene was
+/// once black one-sided leaves, whose lost backs are now counted: `tests/two_sided.rs`. Its
+/// ground took two levels while the sun's small shadows cut it into 125 pieces before refinement;
+/// with the sun's exact lit share it starts in 35 and takes four.)
 #[test]
 fn a_gap_refinement_cannot_close_ends_the_levels_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
@@ -129,7 +132,8 @@ fn a_gap_refinement_cannot_close_ends_the_levels_with_a_warning() {
     assert!(out.status.success(), "not a budget: the answer is written and the command succeeds: {stderr}");
     let s = stats(dir.path());
     let levels = s["levels"].as_array().unwrap();
-    assert!(levels.len() <= 3, "{} levels", levels.len());
+    let first_met = levels.iter().position(|l| l["error_estimate"].as_f64().unwrap() <= 0.01).expect("the estimate meets the target");
+    assert!(levels.len() <= (first_met + 2).min(5), "{} levels, the estimate met the target at level {}", levels.len(), first_met + 1);
     let gap = levels.last().unwrap()["balance_gap"].as_f64().unwrap();
     assert!(gap > pipeline::BALANCE_SHARE_OF_TARGET * 0.01, "the scene must have a gap the levels do not close: {gap}");
     assert_eq!(s["target_missed"]["stopped_by"], "balance_gap", "{}", s["target_missed"]);

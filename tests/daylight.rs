@@ -210,3 +210,43 @@ fn bad_daylight_input_is_one_clear_line() {
         assert!(!err.contains("panicked"));
     }
 }
+
+/// A small tilted square held a metre over a black ground under the sun alone: the ground's mean
+/// irradiance is the sun's on it less the shadow, whose area is the square's times
+/// `|n_square · t| / |n_ground · t|` (a parallel projection, `t` the sun's direction of travel).
+/// The shadow is 0.05% of the ground, smaller than any element the ground would be cut into for
+/// its own sake: the sun's light on each element is its exact lit share, not a quadrature that
+/// could miss it.
+#[test]
+fn a_small_shadow_on_a_large_ground_is_exact_at_the_default_settings() {
+    let (a, tilt) = (0.2f64, 40f64.to_radians());
+    let centre = [0.3, -0.2, 1.0];
+    let (dy, dz) = (0.5 * a * tilt.cos(), 0.5 * a * tilt.sin());
+    let v = |sx: f64, sy: f64| [centre[0] + sx * 0.5 * a, centre[1] + sy * dy, centre[2] + sy * dz];
+    let corners = [v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)];
+    let fmt = |p: [f64; 3]| format!("[{}, {}, {}]", p[0], p[1], p[2]);
+    let toward = [0.0, 0.5, -(0.75f64.sqrt())];
+    let scene = format!(
+        "[[material]]\nname = \"black\"\nreflectance = 0.0\n\
+         [[polygon]]\nmaterial = \"black\"\nvertices = [[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]]\n\
+         [[polygon]]\nmaterial = \"black\"\nvertices = [{}]\n\
+         [sun]\ndirection = [{}, {}, {}]\ndirect_normal = 800\n",
+        corners.map(fmt).join(", "),
+        toward[0],
+        toward[1],
+        toward[2]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    solve(dir.path(), &scene);
+    let (header, rows) = csv(&dir.path().join("out/patches.csv"));
+    let ground = rows[0][column(&header, "h_g")].parse::<f64>().unwrap();
+    let n_square = [0.0, -tilt.sin(), tilt.cos()];
+    let along = |n: [f64; 3]| (n[0] * toward[0] + n[1] * toward[1] + n[2] * toward[2]).abs();
+    let shadow = a * a * along(n_square) / along([0.0, 0.0, 1.0]);
+    let expected = 800.0 * along([0.0, 0.0, 1.0]) * (1.0 - shadow / 100.0);
+    assert!(
+        (ground - expected).abs() < EXACT_TOL * expected,
+        "ground {ground} expected {expected} (unshadowed {})",
+        800.0 * along([0.0, 0.0, 1.0])
+    );
+}

@@ -4,6 +4,7 @@ mod aabb;
 mod mesh;
 mod polygon;
 pub mod quadrature;
+pub mod union_area;
 
 pub use aabb::Aabb;
 pub use glam::DVec3;
