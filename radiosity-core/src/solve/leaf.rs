@@ -195,11 +195,15 @@ pub struct LeafCoefficients {
     scale: Vec<f64>,
     /// Per link, where its source value comes from.
     value: Vec<SourceValue>,
-    /// Weights of source leaves: `(leaf, weight)` ranges referred to by [`SourceValue`].
+    /// The leaves below each source with weights, once per source (every range of weights of a
+    /// source is over the same leaves, in the same order).
     weight_leaf: Vec<ElementId>,
+    /// Weights of source leaves: ranges referred to by [`SourceValue`], each with the start of
+    /// its source's leaves in `weight_leaf`.
     weight: Vec<f64>,
-    /// Sources with shared weights: `(source, start, end)` into `weight_leaf`/`weight`.
-    shared: Vec<(ElementId, usize, usize)>,
+    /// Sources with shared weights: `(source, start, end, leaves)` into `weight`, and the start
+    /// of its leaves in `weight_leaf`.
+    shared: Vec<(ElementId, usize, usize, usize)>,
     /// Smallest and largest closure factor applied ([`LeafCoefficients::closure`]).
     closure: (f64, f64),
     /// Per link, the closure factor on its transfer less 1 (empty in an open scene).
@@ -227,8 +231,9 @@ pub const CLOSURE_MAX: f64 = 1000.0;
 enum SourceValue {
     /// The source is a leaf: its radiosity.
     Leaf(ElementId),
-    /// The link's own weights (`start..end` of the weight arrays, summing to 1).
-    Own(u32, u32),
+    /// The link's own weights (`start..end` of `weight`, summing to 1), and the start of its
+    /// source's leaves in `weight_leaf`.
+    Own(u32, u32, u32),
     /// The weights shared by the source's far links (entry of `shared`).
     Shared(u32),
 }
@@ -520,20 +525,23 @@ impl LeafCoefficients {
             for (k, t) in r.transfer {
                 transfer[k as usize] = t;
             }
+            if r.own.is_empty() && r.shared.is_none() {
+                continue;
+            }
+            let leaves = weight_leaf.len();
+            weight_leaf.extend_from_slice(below.below(s));
             for (k, w) in r.own {
                 let begin = weight.len() as u32;
-                weight_leaf.extend_from_slice(below.below(s));
                 weight.extend(w);
-                value[k as usize] = SourceValue::Own(begin, weight.len() as u32);
+                value[k as usize] = SourceValue::Own(begin, weight.len() as u32, leaves as u32);
             }
             if let Some(w) = r.shared {
                 let begin = weight.len();
-                weight_leaf.extend_from_slice(below.below(s));
                 weight.extend(w);
                 for &k in r.far.iter() {
                     value[k as usize] = SourceValue::Shared(shared.len() as u32);
                 }
-                shared.push((s, begin, weight.len()));
+                shared.push((s, begin, weight.len(), leaves));
             }
         }
         let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
@@ -594,14 +602,15 @@ impl LeafCoefficients {
         for (k, v) in self.value.iter().enumerate() {
             match *v {
                 SourceValue::Leaf(e) => add(e, transfer[k]),
-                SourceValue::Own(lo, hi) => {
-                    for (&y, &q) in self.weight_leaf[lo as usize..hi as usize].iter().zip(&self.weight[lo as usize..hi as usize]) {
+                SourceValue::Own(lo, hi, leaves) => {
+                    let (lo, hi, leaves) = (lo as usize, hi as usize, leaves as usize);
+                    for (&y, &q) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]) {
                         add(y, transfer[k] * q);
                     }
                 }
                 SourceValue::Shared(i) => {
-                    let (_, lo, hi) = self.shared[i as usize];
-                    for (&y, &q) in self.weight_leaf[lo..hi].iter().zip(&self.weight[lo..hi]) {
+                    let (_, lo, hi, leaves) = self.shared[i as usize];
+                    for (&y, &q) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]) {
                         add(y, transfer[k] * q);
                     }
                 }
@@ -611,9 +620,9 @@ impl LeafCoefficients {
         let f = |y: ElementId| cut.unknown_of(y).map_or(1.0, |i| factor[i]);
         // Rescale the weights of each range by the factors, renormalise, and keep each range's
         // mean factor: a link's transfer scales by its range's mean factor.
-        let mut rescale = |lo: usize, hi: usize| -> f64 {
+        let mut rescale = |lo: usize, hi: usize, leaves: usize| -> f64 {
             let mut sum = 0.0;
-            for (&y, w) in self.weight_leaf[lo..hi].iter().zip(&mut self.weight[lo..hi]) {
+            for (&y, w) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&mut self.weight[lo..hi]) {
                 *w *= f(y);
                 sum += *w;
             }
@@ -626,14 +635,14 @@ impl LeafCoefficients {
             .value
             .iter()
             .map(|v| match *v {
-                SourceValue::Own(lo, hi) => Some(rescale(lo as usize, hi as usize)),
+                SourceValue::Own(lo, hi, leaves) => Some(rescale(lo as usize, hi as usize, leaves as usize)),
                 _ => None,
             })
             .collect();
         let shared_scale: Vec<f64> = (0..self.shared.len())
             .map(|i| {
-                let (_, lo, hi) = self.shared[i];
-                rescale(lo, hi)
+                let (_, lo, hi, leaves) = self.shared[i];
+                rescale(lo, hi, leaves)
             })
             .collect();
         self.closure_change = Vec::with_capacity(self.scale.len());
@@ -703,15 +712,15 @@ impl LeafCoefficients {
             + self.value.len() * size_of::<SourceValue>()
             + self.weight_leaf.len() * size_of::<ElementId>()
             + self.weight.len() * size_of::<f64>()
-            + self.shared.len() * size_of::<(ElementId, usize, usize)>()
+            + self.shared.len() * size_of::<(ElementId, usize, usize, usize)>()
     }
 
     /// The radiosity each link sends (see the module docs), for leaf radiosity read from `b` (per
     /// element), times the link's receiver-side scale.
     fn link_values(&self, b: &[[f64; 3]]) -> Vec<[f64; 3]> {
-        let weighted = |lo: usize, hi: usize| {
+        let weighted = |lo: usize, hi: usize, leaves: usize| {
             let mut acc = [0.0; 3];
-            for (&y, &w) in self.weight_leaf[lo..hi].iter().zip(&self.weight[lo..hi]) {
+            for (&y, &w) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]) {
                 let by = b[y as usize];
                 for c in 0..3 {
                     acc[c] += w * by[c];
@@ -719,14 +728,14 @@ impl LeafCoefficients {
             }
             acc
         };
-        let shared: Vec<[f64; 3]> = self.shared.par_iter().map(|&(_, lo, hi)| weighted(lo, hi)).collect();
+        let shared: Vec<[f64; 3]> = self.shared.par_iter().map(|&(_, lo, hi, leaves)| weighted(lo, hi, leaves)).collect();
         self.value
             .par_iter()
             .zip(&self.scale)
             .map(|(v, &s)| {
                 let x = match *v {
                     SourceValue::Leaf(e) => b[e as usize],
-                    SourceValue::Own(lo, hi) => weighted(lo as usize, hi as usize),
+                    SourceValue::Own(lo, hi, leaves) => weighted(lo as usize, hi as usize, leaves as usize),
                     SourceValue::Shared(i) => shared[i as usize],
                 };
                 x.map(|x| x * s)
