@@ -238,6 +238,10 @@ enum SourceValue {
     Shared(u32),
 }
 
+/// Sources whose leaf weights are made at a time when the leaf operator is built (in parallel
+/// within a chunk): their weights are held twice until copied into place.
+pub const WEIGHT_CHUNK: usize = 4096;
+
 /// Links nearer than this (centre distance over the sum of the bounding radii) weight their
 /// source's leaves by their own kernel; farther links share one set of weights per source (the
 /// kernel varies little over a far source).
@@ -517,31 +521,44 @@ impl LeafCoefficients {
         }
         by_source.sort_by_key(|&k| (links[k as usize].source, k));
         let groups: Vec<&[u32]> = by_source.chunk_by(|&a, &b| links[a as usize].source == links[b as usize].source).collect();
-        let results: Vec<SourceWeights> = groups.par_iter().map(|group| source_weights(h, links, &below, group, &transfer)).collect();
-        let (mut weight_leaf, mut weight) = (Vec::new(), Vec::new());
-        let mut shared = Vec::new();
-        for (group, r) in groups.iter().zip(results) {
+        // The weights are made a chunk of sources at a time into vectors of their exact size:
+        // made all at once, then copied into vectors grown by doubling, they held up to three
+        // times their size (573 MB of a 1.01 GB heap peak on a 3,200-leaf canopy).
+        let (mut n_leaves, mut n_weights) = (0, 0);
+        for group in &groups {
             let s = links[group[0] as usize].source;
-            for (k, t) in r.transfer {
-                transfer[k as usize] = t;
-            }
-            if r.own.is_empty() && r.shared.is_none() {
-                continue;
-            }
-            let leaves = weight_leaf.len();
-            weight_leaf.extend_from_slice(below.below(s));
-            for (k, w) in r.own {
-                let begin = weight.len() as u32;
-                weight.extend(w);
-                value[k as usize] = SourceValue::Own(begin, weight.len() as u32, leaves as u32);
-            }
-            if let Some(w) = r.shared {
-                let begin = weight.len();
-                weight.extend(w);
-                for &k in r.far.iter() {
-                    value[k as usize] = SourceValue::Shared(shared.len() as u32);
+            let n = below.below(s).len();
+            let own = group.iter().filter(|&&k| own_weights(h, &below, &links[k as usize])).count();
+            n_leaves += n;
+            n_weights += n * (own + usize::from(own < group.len()));
+        }
+        let (mut weight_leaf, mut weight) = (Vec::with_capacity(n_leaves), Vec::with_capacity(n_weights));
+        let mut shared = Vec::new();
+        for chunk in groups.chunks(WEIGHT_CHUNK) {
+            let results: Vec<SourceWeights> = chunk.par_iter().map(|group| source_weights(h, links, &below, group, &transfer)).collect();
+            for (group, r) in chunk.iter().zip(results) {
+                let s = links[group[0] as usize].source;
+                for (k, t) in r.transfer {
+                    transfer[k as usize] = t;
                 }
-                shared.push((s, begin, weight.len(), leaves));
+                if r.own.is_empty() && r.shared.is_none() {
+                    continue;
+                }
+                let leaves = weight_leaf.len();
+                weight_leaf.extend_from_slice(below.below(s));
+                for (k, w) in r.own {
+                    let begin = weight.len() as u32;
+                    weight.extend(w);
+                    value[k as usize] = SourceValue::Own(begin, weight.len() as u32, leaves as u32);
+                }
+                if let Some(w) = r.shared {
+                    let begin = weight.len();
+                    weight.extend(w);
+                    for &k in r.far.iter() {
+                        value[k as usize] = SourceValue::Shared(shared.len() as u32);
+                    }
+                    shared.push((s, begin, weight.len(), leaves));
+                }
             }
         }
         let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
