@@ -256,40 +256,6 @@ fn measured_polygons(h: &crate::hierarchy::Hierarchy) -> impl Iterator<Item = us
     (0..h.n_polygons as usize).filter(move |&p| all || !emits(p))
 }
 
-/// The error that the quadrature of the direct light (luminaires, distant sources) leaves in the
-/// polygons' means, relative to the largest non-emitting mean: `errors` per polygon and channel
-/// ([`crate::luminaire::direct_polygon_errors`]), times the polygon's reflectance against
-/// `radiosity`'s largest mean (per polygon, or per element with the polygons first); with
-/// `irradiance` (the polygons' mean irradiance, direct light included) the error itself against
-/// its largest mean too, the larger of the two. The error a surface reflects reaches the others
-/// through the links; it is counted where it is made only.
-#[must_use]
-pub fn direct_error_estimate(
-    h: &crate::hierarchy::Hierarchy,
-    errors: &[[f64; 3]],
-    radiosity: &[[f64; 3]],
-    irradiance: Option<&[[f64; 3]]>,
-) -> f64 {
-    if errors.is_empty() {
-        return 0.0;
-    }
-    let top_b = largest_non_emitting_mean(h, radiosity);
-    let top_h = irradiance.map_or(0.0, |e| largest_non_emitting_mean(h, e));
-    let mut worst = 0.0f64;
-    for p in measured_polygons(h) {
-        for c in 0..3 {
-            let e = errors[p][c];
-            if top_b > 0.0 {
-                worst = worst.max(h.reflectance[p][c] * e / top_b);
-            }
-            if top_h > 0.0 {
-                worst = worst.max(e / top_h);
-            }
-        }
-    }
-    worst
-}
-
 /// The largest mean (every channel) of `radiosity` (per polygon, or per element with the polygons
 /// first) over the polygons the estimate measures: what the error estimate is relative to.
 #[must_use]
@@ -376,14 +342,6 @@ pub fn unresolved_per_polygon(h: &crate::hierarchy::Hierarchy, links: &[crate::r
         });
     }
     err
-}
-
-/// The largest of [`unresolved_per_polygon`] over the measured polygons, relative to the largest
-/// non-emitting mean of `radiosity`.
-#[must_use]
-pub fn unresolved_polygons(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> f64 {
-    let err = unresolved_per_polygon(h, links, radiosity);
-    worst_relative(h, radiosity, |q, c| err[q][c])
 }
 
 /// The mesh's and the direct light's error in the polygons' means, each polygon's own terms added
