@@ -50,7 +50,7 @@ fn main() {
                 100.0 * d1 / top,
                 100.0 * d2 / top
             );
-            let noise = solve::ESTIMATE_SAFETY * solve::visibility_noise(h, &s.links, &s.solution.radiosity, None, config.visibility.rays);
+            let noise = solve::ESTIMATE_SAFETY * solve::visibility_noise(h, &s.links, &s.solution.radiosity, None);
             if noise * top < err && factor.is_finite() && factor > largest.0 {
                 largest = (factor, format!("{} eps {eps}", c.name));
             }

@@ -170,6 +170,7 @@ fn a_graph_without_visibility_tools_casts_no_ray() {
         threshold_scale: 1.0,
         shafts: None,
         criterion: Default::default(),
+        reflected_rays: VisibilityConfig::default().rays,
     };
     // The energy part of BF: facing, transfer, subdivision; no visibility tool.
     let energy = GraphBuilder::new("energy")

@@ -545,6 +545,10 @@ pub fn run_with_points(
     let mut rounds = 0;
     let (mut importance_cap, mut importance_refused, mut previous_worst, mut previous_bytes) = (usize::MAX, 0u64, f64::INFINITY, 1usize);
     let max_rounds = if has_points { IMPORTANCE_MAX_ROUNDS } else { 0 };
+    // Calculation points read the links' sampling noise, which their error estimate does not
+    // count: every new link's visibility takes the kept count of segments where there are any.
+    let reflected_rays =
+        if point_sets.iter().any(|s| !s.is_empty()) { config.criterion.kept_rays(config.visibility.rays) } else { config.visibility.rays };
     for level in 0..n_levels + max_rounds {
         let scale = first_scale / config.level_step.powi((level - rounds) as i32);
         // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
@@ -565,6 +569,7 @@ pub fn run_with_points(
                 shafts,
                 limits,
                 config.criterion,
+                reflected_rays,
                 &|l, p| progress(Progress::Refine { level: level + 1, pass, links: l, pending: p }),
             );
             links = new_links;
@@ -891,8 +896,7 @@ fn estimate_error(
         h_means.push(with_direct(results));
     }
     let unresolved = solve::unresolved_per_polygon(h, links, &sol.radiosity);
-    let kept_rays = config.criterion.kept_rays(config.visibility.rays);
-    let noise = solve::visibility_noise(h, links, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()), kept_rays);
+    let noise = solve::visibility_noise(h, links, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()));
     let closure = solve::closure_error(h, links, closure_changes, &sol.radiosity, irradiance.then_some(h_means[0].as_slice()));
     // The direct light's quadrature adds to the mesh's error where a shadow edge crosses leaves.
     let direct_errors = crate::luminaire::direct_polygon_errors(h);

@@ -243,17 +243,11 @@ pub fn projected_area(h: &Hierarchy, e: &Element, dir: DVec3) -> f64 {
     match e.kind {
         crate::hierarchy::ElementKind::Surface { .. } => e.area * e.normal.dot(dir).max(0.0),
         crate::hierarchy::ElementKind::Cluster { poly_start, poly_end } => {
-            let members = &h.cluster_polygons[poly_start as usize..poly_end as usize];
+            let members = &h.cluster_members[poly_start as usize..poly_end as usize];
             if members.len() > CLUSTER_EXACT_MAX_POLYGONS {
                 return 0.25 * e.area;
             }
-            members
-                .iter()
-                .map(|&p| {
-                    let el = h.get(p);
-                    el.area * el.normal.dot(dir).max(0.0)
-                })
-                .sum()
+            members.iter().map(|&(normal, area)| area * normal.dot(dir).max(0.0)).sum()
         }
     }
 }

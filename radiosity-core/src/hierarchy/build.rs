@@ -88,6 +88,7 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         children: Vec::with_capacity(2 * n),
         cluster_polygons: (0..n as u32).collect(),
         cluster_area_prefix: Vec::new(),
+        cluster_members: Vec::new(),
         root: NONE,
         n_polygons: n as u32,
         reflectance,
@@ -111,6 +112,7 @@ pub fn build(scene: &Scene, config: &BuildConfig) -> Hierarchy {
         prefix.push(acc);
     }
     h.cluster_area_prefix = prefix;
+    h.cluster_members = h.cluster_polygons.iter().map(|&p| (h.elements[p as usize].normal, h.elements[p as usize].area)).collect();
     h
 }
 

@@ -104,6 +104,10 @@ pub struct Hierarchy {
     pub cluster_polygons: Vec<u32>,
     /// Prefix sums of polygon areas in `cluster_polygons` order (length + 1), for area sampling.
     pub cluster_area_prefix: Vec<f64>,
+    /// Each polygon's unit normal and area in `cluster_polygons` order: a cluster's projected
+    /// area ([`crate::formfactor::projected_area`]) sums over its members, and read from the
+    /// elements (one cache line each, scattered) that sum was 6% of a canopy's solve.
+    pub cluster_members: Vec<(crate::geom::DVec3, f64)>,
     /// Root cluster.
     pub root: ElementId,
     /// Number of input polygons.
@@ -311,6 +315,19 @@ impl Hierarchy {
         let mate = self.mate(id);
         let other = if mate == NONE { [0.0; 3] } else { self.direct.get(mate as usize).copied().unwrap_or_default() };
         std::array::from_fn(|c| own[c] + self.reflectance[p][c] * d[c] + self.transmittance[p][c] * other[c])
+    }
+
+    /// Whether element `id` holds an emitting polygon (a surface of one, or a cluster with one
+    /// among its members).
+    #[must_use]
+    pub fn holds_emitter(&self, id: ElementId) -> bool {
+        let emits = |p: u32| self.emission[p as usize].iter().any(|&x| x > 0.0);
+        match self.get(id).kind {
+            ElementKind::Surface { polygon, .. } => emits(polygon),
+            ElementKind::Cluster { poly_start, poly_end } => {
+                self.cluster_polygons[poly_start as usize..poly_end as usize].iter().any(|&p| emits(p))
+            }
+        }
     }
 
     /// The length of the diagonal of the scene's bounding box.

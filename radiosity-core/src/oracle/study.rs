@@ -46,6 +46,7 @@ pub fn visibility_study(solved: &Solved, visibility: VisibilityConfig, threshold
         threshold_scale: 1.0,
         shafts: None,
         criterion: crate::refine::Criterion::default(),
+        reflected_rays: visibility.rays,
     };
     // Classify each link once; a fresh context per classifier so none reuses another's rays. Links
     // in parallel: each link's rays are seeded by the link, so the result does not depend on threads.

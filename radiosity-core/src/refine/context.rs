@@ -37,7 +37,9 @@ impl Criterion {
 
     /// How many segments the visibility a new link keeps is sampled with, for `--rays` `rays`:
     /// `rays`, or [`KEPT_VISIBILITY_FACTOR`] times as many under the irradiance criterion
-    /// ([`LinkCtx::fresh_visibility`]). The error estimate's visibility noise counts these.
+    /// ([`LinkCtx::fresh_visibility`]), except for a link of reflected light that the oracle kept
+    /// without drawing any ([`Services::reflected_rays`]). Each link records its count
+    /// ([`crate::refine::Link::rays`]) for the error estimate's visibility noise.
     #[must_use]
     pub fn kept_rays(self, rays: u32) -> u32 {
         match self {
@@ -48,7 +50,8 @@ impl Criterion {
 }
 
 /// Under [`Criterion::Irradiance`], how many times `--rays` segments the visibility kept for a new
-/// link is sampled with ([`LinkCtx::fresh_visibility`]). CIE 171 case 5.7's black sensors at
+/// link is sampled with ([`LinkCtx::fresh_visibility`]; but see [`Services::reflected_rays`]).
+/// CIE 171 case 5.7's black sensors at
 /// `--eps 0.01`, seeds 1–3, worst error: a fresh sample of `--rays` segments 1.6–3.6%, of 4 times
 /// as many 0.41–0.55% (17–23k links, 0.2 s); more rays for the oracle's own decision (up to 16
 /// times, where the estimate's error was over half the threshold) doubled the links and changed
@@ -78,6 +81,11 @@ pub struct Services<'a> {
     pub shafts: Option<ShaftServices<'a>>,
     /// What the criteria bound the error of.
     pub criterion: Criterion,
+    /// Under [`Criterion::Irradiance`], how many segments the visibility of a link of reflected
+    /// light is sampled with when the oracle kept it without drawing any (see
+    /// [`Criterion::kept_rays`]): `--rays`, or the kept count where calculation points read the
+    /// solution (their error estimate does not count the links' sampling noise).
+    pub reflected_rays: u32,
 }
 
 /// Shaft culling shared by a refinement pass.
@@ -296,6 +304,12 @@ impl<'a> LinkCtx<'a> {
             return self.visibility(more);
         }
         v
+    }
+
+    /// How many segments the visibility last sampled for this link was drawn with (0 before any).
+    #[must_use]
+    pub fn sampled_rays(&self) -> u32 {
+        self.data.visibility.map_or(0, |(_, n)| n)
     }
 
     /// Visibility fraction with at least `rays` rays (1 when the scene needs no visibility).

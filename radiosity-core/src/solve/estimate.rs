@@ -144,7 +144,7 @@ pub fn richardson_per_polygon(fine: &[[f64; 3]], coarse: &[[f64; 3]], coarser: &
 pub const NOISE_SIGMAS: f64 = 1.0;
 
 /// The error that visibility sampling leaves in each polygon's mean radiosity, relative to the
-/// largest non-emitting mean: a link whose `rays` segments found it partly occluded has a
+/// largest non-emitting mean: a link whose segments ([`crate::refine::Link::rays`]) found it partly occluded has a
 /// visibility of standard error `√(V (1 − V) / rays)`, which moves its receiver's irradiance by
 /// `B_S F` times that; independent links add in quadrature over a polygon (each weighted by the
 /// share of the polygon's area its receiver covers), and the reflectance turns irradiance into
@@ -159,9 +159,8 @@ pub fn visibility_noise(
     links: &[crate::refine::Link],
     radiosity: &[[f64; 3]],
     irradiance: Option<&[[f64; 3]]>,
-    rays: u32,
 ) -> f64 {
-    let sd = irradiance_noise(h, links, radiosity, rays);
+    let sd = irradiance_noise(h, links, radiosity);
     let of_radiosity = worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * sd[p][c]);
     let of_irradiance = irradiance.map_or(0.0, |means| worst_relative(h, means, |p, c| sd[p][c]));
     NOISE_SIGMAS * of_radiosity.max(of_irradiance)
@@ -207,15 +206,14 @@ pub fn closure_error(
 
 /// One standard deviation of each polygon's mean irradiance from visibility sampling (see
 /// [`visibility_noise`]).
-fn irradiance_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]], rays: u32) -> Vec<[f64; 3]> {
+fn irradiance_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let n = h.n_polygons as usize;
     let mut var = vec![[0.0; 3]; n];
-    let rays = f64::from(rays.max(1));
     for l in links {
         if l.vis <= 0.0 || l.vis >= 1.0 {
             continue;
         }
-        let sd = (l.vis * (1.0 - l.vis) / rays).sqrt() * l.ff;
+        let sd = (l.vis * (1.0 - l.vis) / f64::from(l.rays.max(1))).sqrt() * l.ff;
         let b = radiosity[l.source as usize];
         receiver_polygons(h, l.receiver, |p, share| {
             for c in 0..3 {
@@ -457,7 +455,7 @@ mod tests {
             let r2 = d.length_squared();
             (nx.dot(d).max(0.0) * (-ny.dot(d)).max(0.0)) / (std::f64::consts::PI * r2 * r2)
         };
-        let mut links = vec![Link { source: 0, receiver: 1, ff: 0.0, vis: 1.0 }];
+        let mut links = vec![Link { source: 0, receiver: 1, ff: 0.0, vis: 1.0, rays: 0 }];
         let mut exact = Vec::new();
         for r in [2u32, 3] {
             let (rp, rn) = (polys[r as usize].0, h.get(r).normal);
@@ -472,7 +470,7 @@ mod tests {
                 }
             }
             let m = receiver_points.len() as f64;
-            links.push(Link { source: 1, receiver: r, ff: ff / m, vis: 1.0 });
+            links.push(Link { source: 1, receiver: r, ff: ff / m, vis: 1.0, rays: 0 });
             exact.push(rho * (err / m).abs());
         }
         let mut radiosity = vec![[0.0; 3]; h.len()];
