@@ -4,6 +4,10 @@
 
 use std::process::Command;
 
+/// How many of the links (relative) the shafts' exact segment test may change against the BVH's
+/// on the Cornell box (see `bench_shafts_rows_repeats_and_noise`).
+const GRAZING_LINKS_REL: f64 = 1e-4;
+
 #[test]
 fn bench_shafts_rows_repeats_and_noise() {
     let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
@@ -28,10 +32,20 @@ fn bench_shafts_rows_repeats_and_noise() {
     for m in ["aabb", "obb", "aabb/shaft", "obb/shaft"] {
         assert!(diff(m) <= noise, "{m}: {} against ray noise {noise}", diff(m));
     }
-    // Under BF the shafts cull rays without changing the links; the shaft oracle (BF with the
-    // shaft deciding visibility where it can) drops the links one occluder blocks and skips the
-    // visibility test of links nothing occludes: no more links, fewer rays.
-    assert_eq!(row("obb")["links"], row("rays")["links"]);
+    // Under BF the shafts cull rays without changing the links, up to the segments that graze an
+    // edge: the shafts test their candidates with the exact segment-polygon test, the scene's BVH
+    // with obvhs's f32 triangles, and such a segment can be blocked in one and clear in the other
+    // (1 link of 138,438 after links of reflected light took `--rays` segments, 2026-12-06; none
+    // before). The shaft oracle (BF with the shaft deciding visibility where it can) drops the
+    // links one occluder blocks and skips the visibility test of links nothing occludes: no more
+    // links, fewer rays.
+    let links = |m: &str| row(m)["links"].as_f64().unwrap();
+    assert!(
+        (links("obb") - links("rays")).abs() <= GRAZING_LINKS_REL * links("rays"),
+        "obb {} against rays {}",
+        links("obb"),
+        links("rays")
+    );
     assert!(row("obb")["rays"].as_u64() < row("rays")["rays"].as_u64());
     assert!(row("obb/shaft")["links"].as_u64() <= row("rays")["links"].as_u64());
     assert!(row("obb/shaft")["rays"].as_u64() < row("rays")["rays"].as_u64());
