@@ -137,7 +137,10 @@ fn needs_split(
             }
         }
     }
-    if depth < MAX_SHADOW_DEPTH && light.caster.is_some() {
+    // Under a target error the element's lit share of a sharp distant source is exact
+    // ([`ParallelShadows`]) and its edge steps its radiosity range: where that matters to a
+    // receiver, the oracle splits, and nothing is split for it here.
+    if depth < MAX_SHADOW_DEPTH && light.caster.is_some() && !error_controlled {
         for (k, s) in distant.sources().iter().enumerate() {
             if !s.sharp || s.on(e.normal).iter().all(|&v| v <= 0.0) {
                 continue;
@@ -146,10 +149,7 @@ fn needs_split(
             for (x, _) in quadrature::weighted_points(&poly, element_rule(&poly)) {
                 seen[usize::from(distant.from_one(k, x, e.normal, polygon).1)] = true;
             }
-            // Under a target error the element's lit share is exact ([`ParallelShadows`]) and its
-            // edge steps its radiosity range: where that matters to a receiver, the oracle splits.
-            let edge = seen[1] && !error_controlled;
-            if seen[0] && (edge || (!error_controlled && smaller_shadow_falls_on(h, id, s.toward, occluders))) {
+            if seen[0] && (seen[1] || smaller_shadow_falls_on(h, id, s.toward, occluders)) {
                 return true;
             }
         }

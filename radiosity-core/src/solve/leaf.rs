@@ -621,13 +621,13 @@ impl LeafCoefficients {
                 SourceValue::Leaf(e) => add(e, transfer[k]),
                 SourceValue::Own(lo, hi, leaves) => {
                     let (lo, hi, leaves) = (lo as usize, hi as usize, leaves as usize);
-                    for (&y, &q) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]) {
+                    for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
                         add(y, transfer[k] * q);
                     }
                 }
                 SourceValue::Shared(i) => {
                     let (_, lo, hi, leaves) = self.shared[i as usize];
-                    for (&y, &q) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]) {
+                    for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
                         add(y, transfer[k] * q);
                     }
                 }
@@ -732,12 +732,18 @@ impl LeafCoefficients {
             + self.shared.len() * size_of::<(ElementId, usize, usize, usize)>()
     }
 
+    /// The leaves and weights of the range `lo..hi` of `weight`, whose source's leaves start at
+    /// `leaves` in `weight_leaf`.
+    fn weighted_leaves(&self, lo: usize, hi: usize, leaves: usize) -> impl Iterator<Item = (&ElementId, &f64)> {
+        self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi])
+    }
+
     /// The radiosity each link sends (see the module docs), for leaf radiosity read from `b` (per
     /// element), times the link's receiver-side scale.
     fn link_values(&self, b: &[[f64; 3]]) -> Vec<[f64; 3]> {
         let weighted = |lo: usize, hi: usize, leaves: usize| {
             let mut acc = [0.0; 3];
-            for (&y, &w) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]) {
+            for (&y, &w) in self.weighted_leaves(lo, hi, leaves) {
                 let by = b[y as usize];
                 for c in 0..3 {
                     acc[c] += w * by[c];
