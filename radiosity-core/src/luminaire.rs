@@ -101,8 +101,9 @@ impl<'a> DirectLight<'a> {
 /// luminaire that lights it, crossed by a shadow boundary of a luminaire or of a sharp distant
 /// source (the sun; not the sky's cells, whose shadows are soft), or lit by such a source with a
 /// smaller shadow on it that its rule's points may all miss ([`smaller_shadow_falls_on`]).
-/// `error_controlled` (a target error): the sun's shadow boundaries that the rule's points see
-/// are left to the levels' control of the direct light's error instead (see [`prepare`]).
+/// `error_controlled` (a target error): nothing is split for a distant source (its boundaries and
+/// its smaller shadows alike), nor are its rays traced here; the element's lit share is exact and
+/// the levels' control of the direct light's error splits where it matters (see [`prepare`]).
 fn needs_split(
     h: &Hierarchy,
     id: u32,

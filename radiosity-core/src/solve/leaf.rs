@@ -617,20 +617,19 @@ impl LeafCoefficients {
             }
         };
         for (k, v) in self.value.iter().enumerate() {
-            match *v {
-                SourceValue::Leaf(e) => add(e, transfer[k]),
-                SourceValue::Own(lo, hi, leaves) => {
-                    let (lo, hi, leaves) = (lo as usize, hi as usize, leaves as usize);
-                    for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
-                        add(y, transfer[k] * q);
-                    }
+            let (lo, hi, leaves) = match *v {
+                SourceValue::Leaf(e) => {
+                    add(e, transfer[k]);
+                    continue;
                 }
+                SourceValue::Own(lo, hi, leaves) => (lo as usize, hi as usize, leaves as usize),
                 SourceValue::Shared(i) => {
                     let (_, lo, hi, leaves) = self.shared[i as usize];
-                    for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
-                        add(y, transfer[k] * q);
-                    }
+                    (lo, hi, leaves)
                 }
+            };
+            for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
+                add(y, transfer[k] * q);
             }
         }
         let factor: Vec<f64> = delivered.iter().map(|&d| if d > 0.0 { (1.0 / d).clamp(CLOSURE_MIN, CLOSURE_MAX) } else { 1.0 }).collect();
