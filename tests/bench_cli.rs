@@ -80,3 +80,39 @@ fn bench_canopy_rows_and_reference() {
         }
     }
 }
+
+/// `radiosity bench renderpark` end to end on the Cornell box: one row per target with the solve's
+/// figures and its true errors against the kept reference (another seed, a finer target), each
+/// estimate not below its polygons' true error; a second run reuses the reference.
+#[test]
+fn bench_renderpark_rows_errors_and_kept_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = || {
+        let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+            .args(["bench", "renderpark", "cornell", "--targets", "0.3,0.1", "--reference-target", "0.02", "--json", "--out"])
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).expect("one JSON document");
+        rows
+    };
+    let rows = run();
+    assert_eq!(rows.len(), 2);
+    for (r, target) in rows.iter().zip([0.3, 0.1]) {
+        assert_eq!(r["target"], target);
+        assert_eq!(r["finished"], true, "{r}");
+        for key in ["time_s", "peak_rss_bytes", "links", "error_estimate", "polygon_error", "worst_material_error"] {
+            assert!(r[key].as_f64().is_some_and(|v| v > 0.0), "{key}: {r}");
+        }
+        assert!(r["error_estimate"].as_f64() >= r["polygon_error"].as_f64(), "{r}");
+        assert!(r["worst_material"].as_str().is_some_and(|m| !m.is_empty()), "{r}");
+    }
+    let kept = dir.path().join("cornell/reference/stats.json");
+    let modified = std::fs::metadata(&kept).unwrap().modified().unwrap();
+    let again = run();
+    assert_eq!(std::fs::metadata(&kept).unwrap().modified().unwrap(), modified, "the reference was solved again");
+    assert_eq!(again[0]["polygon_error"], rows[0]["polygon_error"]);
+    let csv = std::fs::read_to_string(dir.path().join("renderpark.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+}

@@ -33,6 +33,10 @@ pub enum BenchCommand {
     /// settings, each in its own process: time, peak RSS, links, estimate, balance, and the
     /// leaves' and ground's absorbed power against an independent photon tracer.
     Canopy(super::bench_canopy::CanopyBenchArgs),
+    /// Interiors lit by many small emitters (RenderPark's scenes by path, and generated ones) at a
+    /// range of target errors against a finer solve: time, peak RSS, links, the estimate and the
+    /// true errors of the polygons and of the worst material, beside RenderPark's default figures.
+    Renderpark(super::bench_renderpark::RenderParkBenchArgs),
 }
 
 /// Arguments of `bench shafts`.
@@ -152,6 +156,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Shafts(args) => bench_shafts(&args),
         BenchCommand::Accuracy(args) => super::bench_accuracy::run(&args),
         BenchCommand::Canopy(args) => super::bench_canopy::run(&args),
+        BenchCommand::Renderpark(args) => super::bench_renderpark::run(&args),
     }
 }
 

@@ -4,6 +4,7 @@ mod bench;
 mod bench_accuracy;
 mod bench_canopy;
 mod bench_reference;
+mod bench_renderpark;
 mod generate;
 #[cfg(feature = "mpi")]
 pub mod mpi;

@@ -253,9 +253,91 @@ pub fn rotated_occluders() -> Scene {
     g.finish(look_at(DVec3::new(7.5, 3.5, 5.8), DVec3::new(3.5, 0.8, 2.5)))
 }
 
+/// A RenderPark-like office, 6 × 2.8 × 4.5 m: eight small lamps (30 cm squares, facing down)
+/// hanging 30 cm under the ceiling in a 4 × 2 grid, four desks (solid blocks) with chairs, a low
+/// partition between them and a cabinet standing off a wall; carpet, walls, ceiling, wood, fabric
+/// and metal of distinct reflectances. 90 polygons. For the error estimate on interiors lit by
+/// many small emitters among furniture (RenderPark's office scenes are GPL and stay outside the
+/// project).
+#[must_use]
+pub fn office() -> Scene {
+    let mut g = Gen::new("office");
+    let carpet = g.material("carpet", [0.25, 0.22, 0.2], 0.0);
+    let wall = g.material("wall", [0.7, 0.68, 0.62], 0.0);
+    let ceiling = g.material("ceiling", [0.8; 3], 0.0);
+    let wood = g.material("wood", [0.5, 0.35, 0.2], 0.0);
+    let fabric = g.material("fabric", [0.3, 0.35, 0.5], 0.0);
+    let metal = g.material("metal", [0.6, 0.6, 0.55], 0.0);
+    let light = g.material("light", [0.0; 3], LIGHT_EXITANCE);
+    let (w, h, d) = (6.0, 2.8, 4.5);
+    g.room(DVec3::ZERO, DVec3::new(w, h, d), wall, &["y-", "y+"]);
+    for (face, q) in box_faces(DVec3::ZERO, DVec3::new(w, h, d), true) {
+        match face {
+            "y-" => g.quad(q, carpet, "floor"),
+            "y+" => g.quad(q, ceiling, "ceiling"),
+            _ => {}
+        }
+    }
+    for i in 0..4 {
+        for j in 0..2 {
+            let (x, z) = (0.9 + 1.4 * i as f64, 1.2 + 2.1 * j as f64);
+            g.light_down(x - 0.15, z - 0.15, x + 0.15, z + 0.15, h - 0.3, light);
+        }
+    }
+    for (x, z, back) in [(1.5, 1.2, -1.0), (3.6, 1.2, -1.0), (1.5, 3.3, 1.0), (3.6, 3.3, 1.0)] {
+        g.solid(DVec3::new(x - 0.7, 0.0, z - 0.4), DVec3::new(x + 0.7, 0.74, z + 0.4), wood, "desk");
+        let zc = z + back * 0.75;
+        g.solid(DVec3::new(x - 0.25, 0.0, zc - 0.25), DVec3::new(x + 0.25, 0.46, zc + 0.25), fabric, "chair");
+    }
+    g.solid(DVec3::new(0.6, 0.0, 2.2), DVec3::new(4.5, 1.2, 2.3), fabric, "partition");
+    g.solid(DVec3::new(5.0, 0.0, 1.4), DVec3::new(5.6, 1.9, 3.1), metal, "cabinet");
+    g.finish(look_at(DVec3::new(5.8, 2.3, 4.3), DVec3::new(2.5, 0.6, 1.5)))
+}
+
+/// A RenderPark-like classroom, 9 × 3.2 × 7 m: eighteen small lamps (20 × 60 cm, facing down) in
+/// three rows hanging 40 cm under the ceiling, sixteen desks and chairs (solid blocks) in four rows,
+/// a teacher's desk and a dark board standing before the front wall. 222 polygons.
+#[must_use]
+pub fn classroom() -> Scene {
+    let mut g = Gen::new("classroom");
+    let floor = g.material("floor", [0.35, 0.3, 0.25], 0.0);
+    let wall = g.material("wall", [0.65, 0.65, 0.6], 0.0);
+    let ceiling = g.material("ceiling", [0.75; 3], 0.0);
+    let wood = g.material("wood", [0.55, 0.4, 0.25], 0.0);
+    let seat = g.material("seat", [0.5, 0.15, 0.1], 0.0);
+    let board = g.material("board", [0.08, 0.15, 0.1], 0.0);
+    let light = g.material("light", [0.0; 3], LIGHT_EXITANCE);
+    let (w, h, d) = (9.0, 3.2, 7.0);
+    g.room(DVec3::ZERO, DVec3::new(w, h, d), wall, &["y-", "y+"]);
+    for (face, q) in box_faces(DVec3::ZERO, DVec3::new(w, h, d), true) {
+        match face {
+            "y-" => g.quad(q, floor, "floor"),
+            "y+" => g.quad(q, ceiling, "ceiling"),
+            _ => {}
+        }
+    }
+    for i in 0..6 {
+        for j in 0..3 {
+            let (x, z) = (1.0 + 1.4 * i as f64, 1.4 + 2.1 * j as f64);
+            g.light_down(x - 0.1, z - 0.3, x + 0.1, z + 0.3, h - 0.4, light);
+        }
+    }
+    for i in 0..4 {
+        for j in 0..4 {
+            let (x, z) = (2.4 + 1.7 * i as f64, 1.2 + 1.5 * j as f64);
+            g.solid(DVec3::new(x - 0.6, 0.0, z - 0.25), DVec3::new(x + 0.6, 0.72, z + 0.25), wood, "desk");
+            g.solid(DVec3::new(x - 0.2, 0.0, z + 0.4), DVec3::new(x + 0.2, 0.45, z + 0.8), seat, "chair");
+        }
+    }
+    g.solid(DVec3::new(0.8, 0.0, 2.7), DVec3::new(1.6, 0.75, 4.3), wood, "teacher's desk");
+    g.solid(DVec3::new(0.15, 0.9, 2.0), DVec3::new(0.2, 2.1, 5.0), board, "board");
+    g.finish(look_at(DVec3::new(8.7, 2.6, 6.7), DVec3::new(2.0, 0.8, 2.5)))
+}
+
 /// Names of the scenes built by code rather than loaded (`radiosity solve NAME`): the embedded
 /// Cornell box and the generated scenes of this module ([`by_name`] builds them).
-pub const NAMES: &[&str] = &["cornell", "gen:duplex", "gen:sj-geometry", "gen:sj-shadow", "gen:stairs", "gen:rotated"];
+pub const NAMES: &[&str] =
+    &["cornell", "gen:duplex", "gen:sj-geometry", "gen:sj-shadow", "gen:stairs", "gen:rotated", "gen:office", "gen:classroom"];
 
 /// The scene of a name in [`NAMES`]; `None` for any other name.
 #[must_use]
@@ -267,6 +349,8 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "gen:sj-shadow" => smits_jensen_shadow(),
         "gen:stairs" => stairs_with_beam(),
         "gen:rotated" => rotated_occluders(),
+        "gen:office" => office(),
+        "gen:classroom" => classroom(),
         _ => return None,
     })
 }
