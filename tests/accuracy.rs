@@ -328,9 +328,11 @@ fn a_coarse_target_stops_at_a_coarse_level_and_meets_itself() {
 /// Ward's room with the two full-height partitions of its "obstructed" variant (x 3–3.1, y 3–6 and
 /// x 7–7.1, y 0–3), which cover pieces of the floor and ceiling: the closure makes up for the
 /// covered parts with factors far from 1, which are geometry and not an error of the links, so the
-/// estimate does not count them and the default target is met at the level it was before the
-/// closure was counted (measured 429k links, 0.38%, 9 s; counting the covers kept it refining to
-/// 8.8M links and 175 s).
+/// estimate does not count them and the default target is met (counting the covers kept it
+/// refining to 8.8M links and 175 s). Measured 2026-12-06: five levels, 3.75M links, estimate
+/// 0.78%, 86 s; the fourth level (891k links) moved a polygon mean by 1.6% of the largest, which
+/// the estimate's floor on the last level's change (`solve::LEVEL_CHANGE_SAFETY`) does not let
+/// pass for 1% (it stopped there at 0.38% before the floor).
 #[test]
 fn partitions_standing_on_the_floor_do_not_stall_the_estimate() {
     use radiosity::geom::DVec3;
@@ -365,7 +367,7 @@ fn partitions_standing_on_the_floor_do_not_stall_the_estimate() {
     let estimate = solved.error_estimate.expect("estimated");
     eprintln!("obstructed room: {} links, estimate {:.2}%", solved.links.len(), 100.0 * estimate);
     assert!(solved.target_missed.is_none() && estimate <= DEFAULT_TARGET, "estimate {estimate}: {:?}", solved.target_missed);
-    assert!(solved.links.len() <= 1_000_000, "{} links", solved.links.len());
+    assert!(solved.links.len() <= 5_000_000, "{} links", solved.links.len());
 }
 
 /// Importance goes where the points are: Ward's room with only the reference points of one

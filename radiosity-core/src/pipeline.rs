@@ -652,6 +652,19 @@ pub fn run_with_points(
         let last = level - rounds + 1 == n_levels || stats.refused_for_memory > 0;
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
+        // Under a target, at least what the last level changed (solve::LEVEL_CHANGE_SAFETY).
+        let estimated = estimated.map(|(e, per_polygon)| match (target_error, change) {
+            (Some(_), Some(c)) => {
+                let changes = history.polygon_changes();
+                let per_polygon = per_polygon
+                    .into_iter()
+                    .enumerate()
+                    .map(|(p, e)| e.max(solve::LEVEL_CHANGE_SAFETY * changes.get(p).copied().unwrap_or(0.0)))
+                    .collect();
+                (e.max(solve::LEVEL_CHANGE_SAFETY * c), per_polygon)
+            }
+            _ => (e, per_polygon),
+        });
         let estimate = estimated.as_ref().map(|e| e.0);
         polygon_errors = estimated.map(|e| e.1).unwrap_or_default();
         let balance_gap = (!lights.distant.is_empty() && target_error.is_some())
@@ -680,7 +693,8 @@ pub fn run_with_points(
         };
         let estimate = estimate.unwrap_or(f64::INFINITY);
         let gap_closed = balance_gap.is_none_or(|g| g <= BALANCE_SHARE_OF_TARGET * target);
-        if estimate <= target && gap_closed {
+        // The first level has no change to show what its links miss: it never meets a target.
+        if estimate <= target && gap_closed && change.is_some() {
             if !has_points || stats.refused_for_memory > 0 {
                 break;
             }
