@@ -31,11 +31,13 @@ fn means(solved: &Solved) -> Vec<[f64; 3]> {
 /// The largest difference of a non-emitting polygon mean (any channel) between `a` and the finer
 /// `b`, relative to the largest such mean of `b`: what the estimate states.
 fn difference(scene: &Scene, a: &Solved, b: &Solved) -> f64 {
-    let emits: Vec<bool> = scene.polygons.iter().map(|p| scene.materials[p.material as usize].emission.iter().any(|&e| e > 0.0)).collect();
-    let (a, b) = (means(a), means(b));
-    let lit = || (0..b.len()).filter(|&p| !emits[p]);
-    let top = lit().flat_map(|p| b[p]).fold(0.0, f64::max);
-    lit().flat_map(|p| (0..3).map(|c| (a[p][c] - b[p][c]).abs()).collect::<Vec<f64>>()).fold(0.0, f64::max) / top
+    let finer: Vec<Option<[f64; 3]>> = scene
+        .polygons
+        .iter()
+        .zip(means(b))
+        .map(|(p, m)| (!scene.materials[p.material as usize].emission.iter().any(|&e| e > 0.0)).then_some(m))
+        .collect();
+    radiosity::validation::true_error(&finer, &means(a))
 }
 
 fn check(name: &str, target: f64, finer_eps: f64) {

@@ -653,17 +653,9 @@ pub fn run_with_points(
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
         // Under a target, at least what the last level changed (solve::LEVEL_CHANGE_SAFETY).
-        let estimated = estimated.map(|(e, per_polygon)| match (target_error, change) {
-            (Some(_), Some(c)) => {
-                let changes = history.polygon_changes();
-                let per_polygon = per_polygon
-                    .into_iter()
-                    .enumerate()
-                    .map(|(p, e)| e.max(solve::LEVEL_CHANGE_SAFETY * changes.get(p).copied().unwrap_or(0.0)))
-                    .collect();
-                (e.max(solve::LEVEL_CHANGE_SAFETY * c), per_polygon)
-            }
-            _ => (e, per_polygon),
+        let estimated = estimated.map(|(e, per_polygon)| match target_error {
+            Some(_) => history.floor_by_change(e, per_polygon),
+            None => (e, per_polygon),
         });
         let estimate = estimated.as_ref().map(|e| e.0);
         polygon_errors = estimated.map(|e| e.1).unwrap_or_default();

@@ -160,15 +160,33 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
     }
 }
 
-/// RenderPark's Galerkin hierarchical radiosity on this machine class (CPU seconds, MB), for the
-/// scenes it was measured on; `None` where it had not finished.
-fn renderpark_reference(name: &str) -> Option<(&'static str, &'static str)> {
+/// RenderPark's Galerkin hierarchical radiosity with clustering at its defaults on this machine
+/// class (CPU seconds, peak RSS in MB; `shared/notes/crates.md`), for the scenes it was measured
+/// on, by file name; `>` where it had not finished.
+pub(super) fn renderpark_reference(name: &str) -> Option<(&'static str, &'static str)> {
     match name {
         "cube.mgf" => Some(("0.31", "19")),
         "office2.mgf" => Some(("3.5", "46")),
         "office3.mgf" | "office.mgf" => Some(("96", "193")),
+        "classroom.mgf" => Some(("147", "599")),
         "soda.mgf" => Some((">233 (unfinished)", ">677")),
         _ => None,
+    }
+}
+
+/// Waits for `child`, killing it after `timeout` seconds: its exit status, `None` when killed.
+pub(super) fn wait_or_kill(child: &mut std::process::Child, timeout: f64) -> std::io::Result<Option<std::process::ExitStatus>> {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait()? {
+            return Ok(Some(status));
+        }
+        if start.elapsed().as_secs_f64() > timeout {
+            child.kill().ok();
+            child.wait().ok();
+            return Ok(None);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
     }
 }
 

@@ -15,7 +15,7 @@
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 #[allow(dead_code)]
 #[path = "../../tests/support/photons.rs"]
@@ -205,17 +205,7 @@ fn solve(exe: &Path, dir: &Path, timeout: f64, extra: &[String]) -> anyhow::Resu
         .spawn()
         .with_context(|| format!("running {}", exe.display()))?;
     let t0 = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait()? {
-            break Some(status);
-        }
-        if t0.elapsed().as_secs_f64() > timeout {
-            child.kill().ok();
-            child.wait().ok();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let status = super::bench::wait_or_kill(&mut child, timeout)?;
     let mut row = Row {
         leaves: 0,
         lai: 0.0,

@@ -12,7 +12,6 @@
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::{Duration, Instant};
 
 /// Arguments of `bench renderpark`.
 #[derive(clap::Args, Debug)]
@@ -45,20 +44,6 @@ pub struct RenderParkBenchArgs {
     pub json: bool,
 }
 
-/// RenderPark's Galerkin hierarchical radiosity with clustering at its defaults, measured on this
-/// machine class (`shared/notes/crates.md`): CPU seconds and peak RSS in MB; `None` where it had not
-/// finished.
-fn renderpark_default(name: &str) -> Option<(&'static str, &'static str)> {
-    match name {
-        "cube.mgf" => Some(("0.31", "19")),
-        "office2.mgf" => Some(("3.5", "46")),
-        "office.mgf" => Some(("96", "193")),
-        "classroom.mgf" => Some(("147", "599")),
-        "soda.mgf" => Some((">233", ">677")),
-        _ => None,
-    }
-}
-
 /// RenderPark's scenes under its folder `dir`, in order of size.
 fn renderpark_scenes(dir: &Path) -> Vec<String> {
     ["cube.mgf", "office2/office2.mgf", "examp1.mgf", "office3/office.mgf", "salon/classroom.mgf", "soda.mgf"]
@@ -84,18 +69,7 @@ fn solve(exe: &Path, scene: &str, target: f64, seed: u64, timeout: f64, out: &Pa
         .stderr(std::process::Stdio::piped())
         .spawn()
         .with_context(|| format!("running {}", exe.display()))?;
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait()? {
-            break status;
-        }
-        if start.elapsed().as_secs_f64() > timeout {
-            child.kill()?;
-            child.wait()?;
-            return Ok(None);
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let Some(status) = super::bench::wait_or_kill(&mut child, timeout)? else { return Ok(None) };
     if !status.success() {
         let mut err = String::new();
         if let Some(mut e) = child.stderr.take() {
@@ -172,11 +146,10 @@ impl Layout {
     }
 
     /// The worst non-emitting polygon's error (any channel) relative to the largest non-emitting
-    /// polygon mean of the reference, as the estimate states it.
+    /// polygon mean of the reference, as the estimate states it ([`radiosity::validation::true_error`]).
     fn polygon_error(&self, run: &[[f64; 3]], reference: &[[f64; 3]]) -> f64 {
-        let lit = || (0..reference.len()).filter(|&p| !self.emits[p]);
-        let top = lit().flat_map(|p| reference[p]).fold(0.0, f64::max);
-        lit().flat_map(|p| (0..3).map(move |c| (run[p][c] - reference[p][c]).abs())).fold(0.0, f64::max) / top
+        let lit: Vec<Option<[f64; 3]>> = reference.iter().zip(&self.emits).map(|(r, &e)| (!e).then_some(*r)).collect();
+        radiosity::validation::true_error(&lit, run)
     }
 
     /// Area-weighted luminance mean of each non-emitting material: `(mean, area)` by material.
@@ -302,7 +275,7 @@ pub fn run(args: &RenderParkBenchArgs) -> anyhow::Result<()> {
                 s["links"].as_u64().unwrap_or(0),
                 100.0 * s["error_estimate"].as_f64().unwrap_or(f64::NAN),
                 args.reference_seed,
-                renderpark_default(&name).map_or(String::new(), |(t, m)| format!("; RenderPark's default: {t} s, {m} MB"))
+                super::bench::renderpark_reference(&name).map_or(String::new(), |(t, m)| format!("; RenderPark's default: {t} s, {m} MB"))
             );
         }
     }

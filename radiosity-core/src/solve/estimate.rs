@@ -59,27 +59,31 @@ impl LevelHistory {
     /// largest non-emitting mean), `None` for the first.
     pub fn push(&mut self, means: Vec<[f64; 3]>) -> Option<f64> {
         let change = self.last.as_ref().map(|last| {
-            let mut top = 0.0f64;
-            let mut worst = 0.0f64;
-            for ((m, l), &e) in means.iter().zip(last).zip(&self.emitting) {
-                if e {
-                    continue;
-                }
-                for c in 0..3 {
-                    top = top.max(m[c]);
-                    worst = worst.max((m[c] - l[c]).abs());
-                }
-            }
+            self.polygon_changes = means.iter().zip(last).map(|(m, l)| (0..3).map(|c| (m[c] - l[c]).abs()).fold(0.0, f64::max)).collect();
+            let lit = || (0..means.len()).filter(|&p| !self.emitting[p]);
+            let top = lit().flat_map(|p| means[p]).fold(0.0, f64::max);
+            let worst = lit().map(|p| self.polygon_changes[p]).fold(0.0, f64::max);
             if top > 0.0 { worst / top } else { 0.0 }
         });
         if let Some(d) = change {
             self.changes.push(d);
         }
-        if let Some(last) = &self.last {
-            self.polygon_changes = means.iter().zip(last).map(|(m, l)| (0..3).map(|c| (m[c] - l[c]).abs()).fold(0.0, f64::max)).collect();
-        }
         self.last = Some(means);
         change
+    }
+
+    /// An error estimate under a target error raised to [`LEVEL_CHANGE_SAFETY`] times the last
+    /// level's change: the whole (`estimate`, relative) by the largest change, each polygon's
+    /// (`per_polygon`, W/m²) by its own. Unchanged before the second level.
+    #[must_use]
+    pub fn floor_by_change(&self, estimate: f64, per_polygon: Vec<f64>) -> (f64, Vec<f64>) {
+        let Some(&change) = self.changes.last() else { return (estimate, per_polygon) };
+        let per_polygon = per_polygon
+            .into_iter()
+            .enumerate()
+            .map(|(p, e)| e.max(LEVEL_CHANGE_SAFETY * self.polygon_changes.get(p).copied().unwrap_or(0.0)))
+            .collect();
+        (estimate.max(LEVEL_CHANGE_SAFETY * change), per_polygon)
     }
 
     /// Each polygon's change over the last level, largest channel, absolute (W/m²); empty until
