@@ -690,18 +690,23 @@ pub const DIRECT_FLOOR_REL: f64 = 1e-2;
 /// mean direct irradiance meets `tolerance`: those
 /// with a quadrature error ([`Hierarchy::direct_error`]) on a polygon whose error
 /// ([`direct_polygon_errors`]) exceeds `tolerance` times its own mean direct irradiance (at
-/// least [`DIRECT_FLOOR_REL`] of the largest polygon's), in the largest channel. Empty without
-/// luminaires or distant sources.
+/// least [`DIRECT_FLOOR_REL`] of the largest polygon's), in the largest channel, times the
+/// polygon's entry of `polygon_factor` (1 where it has none). Empty without luminaires or distant
+/// sources.
 #[must_use]
-pub fn direct_splits(h: &Hierarchy, tolerance: f64) -> Vec<u32> {
+pub fn direct_splits(h: &Hierarchy, tolerance: f64, polygon_factor: &[f64]) -> Vec<u32> {
     let errors = direct_polygon_errors(h);
     if errors.is_empty() {
         return Vec::new();
     }
     let means = polygon_direct_means(h);
     let top = means.iter().flatten().copied().fold(0.0, f64::max);
-    let over: Vec<bool> =
-        errors.iter().zip(&means).map(|(e, m)| (0..3).any(|c| e[c] > tolerance * m[c].max(DIRECT_FLOOR_REL * top))).collect();
+    let over: Vec<bool> = (errors.iter().zip(&means).enumerate())
+        .map(|(p, (e, m))| {
+            let tolerance = tolerance * polygon_factor.get(p).copied().unwrap_or(1.0);
+            (0..3).any(|c| e[c] > tolerance * m[c].max(DIRECT_FLOOR_REL * top))
+        })
+        .collect();
     if !over.iter().any(|&o| o) {
         return Vec::new();
     }

@@ -38,6 +38,13 @@ pub struct Config {
     pub target_error: Option<f64>,
     /// Most levels a target error may take.
     pub max_levels: usize,
+    /// Under a target error, from the third level on refine further only the polygons whose own
+    /// estimate is over [`LOCAL_SHARE_OF_TARGET`] of the target and those that send one of them
+    /// [`LOCAL_SOURCE_SHARE`] of its light or more (their links' thresholds, and their direct
+    /// light's tolerance, divided by `level_step`), not every polygon. A polygon left as it was
+    /// keeps the change of the last level that refined it as its estimate's floor
+    /// ([`solve::LevelHistory::refining`]).
+    pub local_levels: bool,
     /// Memory refinement may use (bytes, estimated): beyond it no link is subdivided any more
     /// (see [`refine::RefineLimits`]); the leaf-resolution solve stays within what is left.
     pub max_memory_bytes: usize,
@@ -91,6 +98,7 @@ impl Default for Config {
             level_step: DEFAULT_LEVEL_STEP,
             target_error: None,
             max_levels: DEFAULT_MAX_LEVELS,
+            local_levels: true,
             max_memory_bytes: default_memory_budget(),
             use_visibility: true,
             analyse: true,
@@ -549,8 +557,13 @@ pub fn run_with_points(
     // count: every new link's visibility takes the kept count of segments where there are any.
     let reflected_rays =
         if point_sets.iter().any(|s| !s.is_empty()) { config.criterion.kept_rays(config.visibility.rays) } else { config.visibility.rays };
+    // Local levels: from the third level on, the scale stays and only the polygons whose own
+    // estimate is over the target are refined further, by `polygon_factor` (see
+    // `Config::local_levels`).
+    let local = config.local_levels && target_error.is_some();
+    let (mut held_levels, mut polygon_factor) = (0usize, Vec::<f64>::new());
     for level in 0..n_levels + max_rounds {
-        let scale = first_scale / config.level_step.powi((level - rounds) as i32);
+        let scale = first_scale / config.level_step.powi((level - rounds - held_levels) as i32);
         // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
         let limits = refine::RefineLimits {
             max_bytes: if rounds > 0 { config.max_memory_bytes.min(importance_cap) } else { config.max_memory_bytes },
@@ -589,7 +602,8 @@ pub fn run_with_points(
             }
             let direct_limit = limits.max_bytes.saturating_sub(links.len() * refine::BYTES_PER_LINK);
             let direct_tolerance = direct_tolerance(target_error, scale);
-            s.subdivided += refine_direct(&mut h, &mut data, &mut quadrature, &lights, direct_caster, direct_tolerance, direct_limit);
+            s.subdivided +=
+                refine_direct(&mut h, &mut data, &mut quadrature, &lights, direct_caster, direct_tolerance, &polygon_factor, direct_limit);
             timings.refine += t.elapsed().as_secs_f64();
             stats.oracle_calls += s.oracle_calls;
             stats.form_factors += s.form_factors;
@@ -648,6 +662,7 @@ pub fn run_with_points(
         timings.refine += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let means: Vec<[f64; 3]> = crate::output::polygon_results(&h, &sol).into_iter().map(|r| r.b).collect();
+        let top = solve::largest_non_emitting_mean(&h, &sol.radiosity);
         let change = history.push(means);
         let last = level - rounds + 1 == n_levels || stats.refused_for_memory > 0;
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
@@ -747,6 +762,7 @@ pub fn run_with_points(
                     &lights,
                     direct_caster,
                     direct_tolerance(target_error, scale),
+                    &polygon_factor,
                     direct_limit,
                 );
             }
@@ -783,6 +799,22 @@ pub fn run_with_points(
                 levels: levels.len(),
             });
             break;
+        }
+        if local && change.is_some() {
+            let over: Vec<bool> = polygon_errors.iter().map(|&e| e > LOCAL_SHARE_OF_TARGET * target * top).collect();
+            // When no polygon's own estimate is over (the scene-wide terms or the irradiance of
+            // black surfaces hold the whole up), every polygon is refined.
+            if over.iter().any(|&o| o) {
+                let radiosity = &solution.as_ref().expect("solved above").radiosity;
+                let over = with_sources(&h, &links, radiosity, over);
+                held_levels += 1;
+                polygon_factor.resize(h.n_polygons as usize, 1.0);
+                for p in (0..over.len()).filter(|&p| over[p]) {
+                    polygon_factor[p] /= config.level_step;
+                    data.tighten_subtree(&h, p as u32, 1.0 / config.level_step);
+                }
+                history.refining(over);
+            }
         }
     }
     let mut solution = solution.expect("at least one level solves");
@@ -929,6 +961,43 @@ fn estimate_error(
     (estimate, per_polygon)
 }
 
+/// `over` with the polygons that send an over polygon at least [`LOCAL_SOURCE_SHARE`] of the
+/// light it receives (through links between surfaces).
+fn with_sources(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], over: Vec<bool>) -> Vec<bool> {
+    let n = over.len();
+    let mut total = vec![0.0; n];
+    let mut from: std::collections::HashMap<(u32, u32), f64> = std::collections::HashMap::new();
+    for l in links {
+        let (Some(p), Some(q)) = (h.get(l.receiver).polygon(), h.get(l.source).polygon()) else { continue };
+        if p == q || !over[p as usize] {
+            continue;
+        }
+        let power = l.ff * l.vis * radiosity[l.source as usize].iter().copied().fold(0.0, f64::max) * h.get(l.receiver).area;
+        total[p as usize] += power;
+        *from.entry((p, q)).or_default() += power;
+    }
+    let mut out = over;
+    for ((p, q), power) in from {
+        if power >= LOCAL_SOURCE_SHARE * total[p as usize] {
+            out[q as usize] = true;
+        }
+    }
+    out
+}
+
+/// Under local levels ([`Config::local_levels`]) the polygons that send a polygon refined
+/// further at least this share of the light it receives (through links between surfaces) are
+/// refined further too. How their light is spread over them, which their own mean does not show
+/// and their own links' thresholds set, is part of what that polygon's mean reads: refining the
+/// polygons over the target alone, the corner room of ρ 0.7 at the default target stopped with an
+/// estimate of 0.50% for a true error of 0.95% (its brightest wall's error fell from 1.18% to
+/// 0.95% over a level that changed it by 0.23%).
+pub const LOCAL_SOURCE_SHARE: f64 = 0.1;
+
+/// Under local levels ([`Config::local_levels`]) a polygon is refined further while its own
+/// estimate is over this share of the target: its sources' refinement still changes it.
+pub const LOCAL_SHARE_OF_TARGET: f64 = 0.5;
+
 /// The share of the target error each polygon's mean direct irradiance is held to by
 /// `refine_direct`: with [`solve::ESTIMATE_SAFETY`] on it, about half the target.
 pub const DIRECT_SHARE_OF_TARGET: f64 = 0.2;
@@ -968,13 +1037,14 @@ fn refine_direct(
     lights: &crate::light::Lights,
     caster: Option<&RayCaster>,
     tolerance: Option<f64>,
+    polygon_factor: &[f64],
     max_bytes: usize,
 ) -> u64 {
     crate::luminaire::update_direct(h, lights, caster);
     let Some(tolerance) = tolerance else { return 0 };
     let mut made = 0;
     for _ in 0..DIRECT_MAX_ROUNDS {
-        let over = crate::luminaire::direct_splits(h, tolerance);
+        let over = crate::luminaire::direct_splits(h, tolerance, polygon_factor);
         quadrature.resize(h.len(), 1);
         // Finer quadrature first (shadow rays only), then smaller elements (links as well).
         let (mut split, mut deepen): (Vec<u32>, Vec<(u32, u32)>) = (Vec::new(), Vec::new());

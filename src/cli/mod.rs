@@ -117,6 +117,11 @@ pub struct CommonOptions {
     /// reflectance: black sensors and dark floors refined like white walls).
     #[arg(long, default_value = "irradiance", value_parser = ["radiosity", "irradiance"])]
     pub criterion: String,
+    /// Under a target error, refine every polygon at every level, instead of only those whose own
+    /// estimate is over half the target and the polygons that send them a tenth of their light
+    /// or more (from the third level on).
+    #[arg(long)]
+    pub global_levels: bool,
     /// Memory refinement may use, MB (default: half the machine's physical memory): beyond it no
     /// link is subdivided any more, and stats.json says so.
     #[arg(long, value_name = "MB")]
@@ -176,6 +181,7 @@ impl CommonOptions {
         config.visibility.seed = self.seed;
         config.build.min_area_rel = self.min_area;
         config.use_visibility = !self.no_visibility;
+        config.local_levels = !self.global_levels;
         // clap accepts only the names `VisibilityMethod::name` gives.
         use radiosity::pipeline::VisibilityMethod;
         config.visibility_method = VisibilityMethod::from_name(&self.visibility).unwrap_or(VisibilityMethod::Rays);

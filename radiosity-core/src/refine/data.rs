@@ -148,6 +148,25 @@ impl ElementData {
         }
     }
 
+    /// Scales the thresholds of links to `element` and to every element below it by `factor` (at
+    /// most 1), and to its ancestors as far as the element's new factor: a whole polygon refined
+    /// further than the rest (local levels, see `pipeline`'s `Config::local_levels`).
+    pub fn tighten_subtree(&mut self, h: &Hierarchy, element: ElementId, factor: f64) {
+        self.importance.resize(h.len(), 1.0);
+        let mut stack = vec![element];
+        while let Some(e) = stack.pop() {
+            self.importance[e as usize] *= factor;
+            stack.extend_from_slice(h.children_of(e));
+        }
+        let w = self.importance[element as usize];
+        let mut e = h.get(element).parent;
+        while e != crate::hierarchy::NONE {
+            let slot = &mut self.importance[e as usize];
+            *slot = slot.min(w);
+            e = h.get(e).parent;
+        }
+    }
+
     /// The irradiance a threshold on links to `receiver` is relative to: its reference, at least
     /// the floor, divided by the [`ElementData::amplification`].
     #[must_use]
@@ -162,6 +181,43 @@ impl ElementData {
 mod tests {
     use super::*;
     use crate::hierarchy::{self, BuildConfig};
+
+    /// Tightening a polygon's subtree scales every element of it, the deepest included, and its
+    /// ancestors as far as the polygon's root; a second polygon is left as it was.
+    #[test]
+    fn tightening_a_subtree_scales_every_element_of_it() {
+        let scene = crate::scene::cornell_box();
+        let mut h = hierarchy::build(&scene, &BuildConfig::default());
+        let mut data = ElementData::first_guess(&h);
+        assert!(h.subdivide(0));
+        data.inherit(&h, 0);
+        let child = h.children_of(0)[0];
+        assert!(h.subdivide(child));
+        data.inherit(&h, child);
+        data.tighten(&h, h.children_of(child)[0], 0.5);
+        data.tighten_subtree(&h, 0, 0.25);
+        let mut below = vec![0];
+        let mut i = 0;
+        while i < below.len() {
+            below.extend_from_slice(h.children_of(below[i]));
+            i += 1;
+        }
+        assert!(below.len() >= 9, "two levels below the root: {}", below.len());
+        let deepest = h.children_of(child)[0];
+        for &e in &below {
+            let want = if e == deepest {
+                0.125
+            } else if e == 0 || e == child {
+                0.125
+            } else {
+                0.25
+            };
+            assert!((data.importance[e as usize] - want).abs() < 1e-12, "element {e}: {}", data.importance[e as usize]);
+        }
+        let root = h.root as usize;
+        assert!((data.importance[root] - 0.125).abs() < 1e-12);
+        assert_eq!(data.importance[1], 1.0, "another polygon");
+    }
 
     /// Tightening a leaf scales the reference of the links to it and to every ancestor, and no
     /// other element's; its children inherit its factor; a second tightening multiplies.

@@ -42,6 +42,15 @@ pub struct LevelHistory {
     /// Each polygon's change over the last level (largest channel, absolute; empty before the
     /// second level).
     polygon_changes: Vec<f64>,
+    /// Which polygons the level being refined now refines further (empty: all), see
+    /// [`LevelHistory::refining`].
+    refined: Vec<bool>,
+    /// Each polygon's change the floor reads: its own over the last level it was refined at, or
+    /// what its sources changed it by since, whichever is larger.
+    floor_changes: Vec<f64>,
+    /// The largest of `floor_changes` over the measured polygons, relative to the largest
+    /// non-emitting mean.
+    floor_change: Option<f64>,
 }
 
 impl LevelHistory {
@@ -52,7 +61,15 @@ impl LevelHistory {
         if emitting.iter().all(|&e| e) {
             emitting.fill(false);
         }
-        LevelHistory { emitting, last: None, changes: Vec::new(), polygon_changes: Vec::new() }
+        LevelHistory { emitting, ..LevelHistory::default() }
+    }
+
+    /// Says which polygons the next level refines further (local levels, `pipeline`'s
+    /// `Config::local_levels`): a polygon left as it was keeps the change it showed the last time
+    /// it was refined as its floor ([`LevelHistory::floor_by_change`]), for a level that does not
+    /// refine its links cannot show what they miss.
+    pub fn refining(&mut self, refined: Vec<bool>) {
+        self.refined = refined;
     }
 
     /// Records a level's polygon means; returns the change since the level before (relative to the
@@ -60,10 +77,16 @@ impl LevelHistory {
     pub fn push(&mut self, means: Vec<[f64; 3]>) -> Option<f64> {
         let change = self.last.as_ref().map(|last| {
             self.polygon_changes = means.iter().zip(last).map(|(m, l)| (0..3).map(|c| (m[c] - l[c]).abs()).fold(0.0, f64::max)).collect();
+            let held = std::mem::take(&mut self.floor_changes);
+            let refined = std::mem::take(&mut self.refined);
+            self.floor_changes = (self.polygon_changes.iter().enumerate())
+                .map(|(p, &d)| if refined.get(p).is_none_or(|&r| r) { d } else { d.max(held.get(p).copied().unwrap_or(0.0)) })
+                .collect();
             let lit = || (0..means.len()).filter(|&p| !self.emitting[p]);
             let top = lit().flat_map(|p| means[p]).fold(0.0, f64::max);
-            let worst = lit().map(|p| self.polygon_changes[p]).fold(0.0, f64::max);
-            if top > 0.0 { worst / top } else { 0.0 }
+            let relative = |changes: &[f64]| if top > 0.0 { lit().map(|p| changes[p]).fold(0.0, f64::max) / top } else { 0.0 };
+            self.floor_change = Some(relative(&self.floor_changes));
+            relative(&self.polygon_changes)
         });
         if let Some(d) = change {
             self.changes.push(d);
@@ -74,14 +97,16 @@ impl LevelHistory {
 
     /// An error estimate under a target error raised to [`LEVEL_CHANGE_SAFETY`] times the last
     /// level's change: the whole (`estimate`, relative) by the largest change, each polygon's
-    /// (`per_polygon`, W/m²) by its own. Unchanged before the second level.
+    /// (`per_polygon`, W/m²) by its own. A polygon the last level did not refine
+    /// ([`LevelHistory::refining`]) keeps the change of the last level that did as its floor.
+    /// Unchanged before the second level.
     #[must_use]
     pub fn floor_by_change(&self, estimate: f64, per_polygon: Vec<f64>) -> (f64, Vec<f64>) {
-        let Some(&change) = self.changes.last() else { return (estimate, per_polygon) };
+        let Some(change) = self.floor_change else { return (estimate, per_polygon) };
         let per_polygon = per_polygon
             .into_iter()
             .enumerate()
-            .map(|(p, e)| e.max(LEVEL_CHANGE_SAFETY * self.polygon_changes.get(p).copied().unwrap_or(0.0)))
+            .map(|(p, e)| e.max(LEVEL_CHANGE_SAFETY * self.floor_changes.get(p).copied().unwrap_or(0.0)))
             .collect();
         (estimate.max(LEVEL_CHANGE_SAFETY * change), per_polygon)
     }
@@ -426,6 +451,27 @@ mod tests {
             assert!((got - want).abs() < 1e-12, "{per_polygon:?}");
         }
         assert_eq!(history.changes().len(), 1);
+    }
+
+    /// A polygon a level leaves as it was keeps the change of the last level that refined it as
+    /// its floor, unless what it changes by now is larger; a refined one takes its new change.
+    #[test]
+    fn level_history_holds_the_change_of_polygons_left_as_they_were() {
+        let mut history = LevelHistory::new(vec![false, false, false]);
+        history.push(vec![[10.0; 3], [4.0; 3], [2.0; 3]]);
+        history.push(vec![[10.0; 3], [4.4; 3], [2.2; 3]]);
+        history.refining(vec![true, false, false]);
+        let change = history.push(vec![[10.1; 3], [4.41; 3], [2.5; 3]]).expect("a change");
+        assert!((change - 0.3 / 10.1).abs() < 1e-9, "{change}");
+        let (estimate, per_polygon) = history.floor_by_change(0.0, vec![0.0; 3]);
+        for (got, want) in per_polygon.iter().zip([0.1, 0.4, 0.3]) {
+            assert!((got - LEVEL_CHANGE_SAFETY * want).abs() < 1e-9, "{per_polygon:?}");
+        }
+        assert!((estimate - LEVEL_CHANGE_SAFETY * 0.4 / 10.1).abs() < 1e-9, "{estimate}");
+        // The mask is for one level: the next refines every polygon again.
+        history.push(vec![[10.1; 3], [4.42; 3], [2.5; 3]]);
+        let (_, per_polygon) = history.floor_by_change(0.0, vec![0.0; 3]);
+        assert!((per_polygon[1] - LEVEL_CHANGE_SAFETY * 0.01).abs() < 1e-9, "{per_polygon:?}");
     }
 
     fn square(x0: f64, y0: f64, z: f64, side: f64, up: bool) -> Poly {
