@@ -39,11 +39,11 @@ pub struct Config {
     /// Most levels a target error may take.
     pub max_levels: usize,
     /// Under a target error, from the third level on refine further only the polygons whose own
-    /// estimate is over [`LOCAL_SHARE_OF_TARGET`] of the target and those that send one of them
-    /// [`LOCAL_SOURCE_SHARE`] of its light or more (their links' thresholds, and their direct
-    /// light's tolerance, divided by `level_step`), not every polygon. A polygon left as it was
-    /// keeps the change of the last level that refined it as its estimate's floor
-    /// ([`solve::LevelHistory::refining`]).
+    /// estimate is over [`LOCAL_SHARE_OF_TARGET`] of the target, and of the polygons that send
+    /// one of them [`LOCAL_SOURCE_SHARE`] of its light or more the elements that send it (their
+    /// links' thresholds, and their direct light's tolerance, divided by `level_step`), not every
+    /// polygon. A polygon not over keeps the largest change since it last was as its estimate's
+    /// floor ([`solve::LevelHistory::refining`]).
     pub local_levels: bool,
     /// Memory refinement may use (bytes, estimated): beyond it no link is subdivided any more
     /// (see [`refine::RefineLimits`]); the leaf-resolution solve stays within what is left.
@@ -260,6 +260,10 @@ pub struct LevelReport {
     /// otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub points_error: Option<f64>,
+    /// Under local levels ([`Config::local_levels`]): how many polygons this level refined
+    /// further than the level before; absent where it refined every polygon.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub polygons_refined: Option<usize>,
 }
 
 /// With daylight and a target error, the levels also run on until the power balance closes within
@@ -558,10 +562,10 @@ pub fn run_with_points(
     let reflected_rays =
         if point_sets.iter().any(|s| !s.is_empty()) { config.criterion.kept_rays(config.visibility.rays) } else { config.visibility.rays };
     // Local levels: from the third level on, the scale stays and only the polygons whose own
-    // estimate is over the target are refined further, by `polygon_factor` (see
-    // `Config::local_levels`).
+    // estimate is over the target (and where their light comes from) are refined further, by
+    // `polygon_factor` and the elements' importance (see `Config::local_levels`).
     let local = config.local_levels && target_error.is_some();
-    let (mut held_levels, mut polygon_factor) = (0usize, Vec::<f64>::new());
+    let (mut held_levels, mut polygon_factor, mut polygons_refined) = (0usize, Vec::<f64>::new(), None);
     for level in 0..n_levels + max_rounds {
         let scale = first_scale / config.level_step.powi((level - rounds - held_levels) as i32);
         // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
@@ -687,6 +691,7 @@ pub fn run_with_points(
             change,
             error_estimate: estimate,
             time_s: t0.elapsed().as_secs_f64(),
+            polygons_refined: polygons_refined.take(),
         };
         progress(Progress::Level { level: level + 1, report });
         let previous = levels.last().copied();
@@ -806,13 +811,18 @@ pub fn run_with_points(
             // black surfaces hold the whole up), every polygon is refined.
             if over.iter().any(|&o| o) {
                 let radiosity = &solution.as_ref().expect("solved above").radiosity;
-                let over = with_sources(&h, &links, radiosity, over);
+                let (elements, touched) = local_refinement(&h, &links, radiosity, &over);
                 held_levels += 1;
                 polygon_factor.resize(h.n_polygons as usize, 1.0);
-                for p in (0..over.len()).filter(|&p| over[p]) {
+                for p in (0..touched.len()).filter(|&p| touched[p]) {
                     polygon_factor[p] /= config.level_step;
-                    data.tighten_subtree(&h, p as u32, 1.0 / config.level_step);
                 }
+                for e in elements {
+                    data.tighten_subtree(&h, e, 1.0 / config.level_step);
+                }
+                polygons_refined = Some(touched.iter().filter(|&&o| o).count());
+                // A source refined in part keeps its floor (the largest of its changes since it
+                // was last over) like one left as it was.
                 history.refining(over);
             }
         }
@@ -961,12 +971,14 @@ fn estimate_error(
     (estimate, per_polygon)
 }
 
-/// `over` with the polygons that send an over polygon at least [`LOCAL_SOURCE_SHARE`] of the
-/// light it receives (through links between surfaces).
-fn with_sources(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], over: Vec<bool>) -> Vec<bool> {
+/// What a local level refines further: each polygon of `over` whole, and of every polygon that
+/// sends one of them at least [`LOCAL_SOURCE_SHARE`] of the light it receives (through links
+/// between surfaces), the elements that send it (each with what lies below it). Returns the
+/// elements to tighten (none below another) and which polygons are touched.
+fn local_refinement(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], over: &[bool]) -> (Vec<u32>, Vec<bool>) {
     let n = over.len();
     let mut total = vec![0.0; n];
-    let mut from: std::collections::HashMap<(u32, u32), f64> = std::collections::HashMap::new();
+    let mut from: std::collections::BTreeMap<(u32, u32), f64> = std::collections::BTreeMap::new();
     for l in links {
         let (Some(p), Some(q)) = (h.get(l.receiver).polygon(), h.get(l.source).polygon()) else { continue };
         if p == q || !over[p as usize] {
@@ -976,18 +988,43 @@ fn with_sources(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], over: Vec
         total[p as usize] += power;
         *from.entry((p, q)).or_default() += power;
     }
-    let mut out = over;
-    for ((p, q), power) in from {
-        if power >= LOCAL_SOURCE_SHARE * total[p as usize] {
-            out[q as usize] = true;
+    let strong: std::collections::BTreeSet<(u32, u32)> =
+        from.into_iter().filter(|&((p, _), power)| power >= LOCAL_SOURCE_SHARE * total[p as usize]).map(|(k, _)| k).collect();
+    let mut marked = vec![false; h.len()];
+    for p in (0..n).filter(|&p| over[p]) {
+        marked[p] = true;
+    }
+    for l in links {
+        let (Some(p), Some(q)) = (h.get(l.receiver).polygon(), h.get(l.source).polygon()) else { continue };
+        if strong.contains(&(p, q)) {
+            marked[l.source as usize] = true;
         }
     }
-    out
+    let mut touched = over.to_vec();
+    let mut elements = Vec::new();
+    for e in 0..h.len() as u32 {
+        if !marked[e as usize] {
+            continue;
+        }
+        let mut a = h.get(e).parent;
+        let mut covered = false;
+        while a != crate::hierarchy::NONE {
+            covered |= marked[a as usize];
+            a = h.get(a).parent;
+        }
+        if !covered {
+            elements.push(e);
+            if let Some(p) = h.get(e).polygon() {
+                touched[p as usize] = true;
+            }
+        }
+    }
+    (elements, touched)
 }
 
-/// Under local levels ([`Config::local_levels`]) the polygons that send a polygon refined
-/// further at least this share of the light it receives (through links between surfaces) are
-/// refined further too. How their light is spread over them, which their own mean does not show
+/// Under local levels ([`Config::local_levels`]) the polygons that send a polygon over the target
+/// at least this share of the light it receives (through links between surfaces) are refined
+/// further too, where they send it from. How their light is spread over them, which their own mean does not show
 /// and their own links' thresholds set, is part of what that polygon's mean reads: refining the
 /// polygons over the target alone, the corner room of ρ 0.7 at the default target stopped with an
 /// estimate of 0.50% for a true error of 0.95% (its brightest wall's error fell from 1.18% to
@@ -1150,6 +1187,30 @@ fn finish_solve(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A local level refines the polygon over the target whole, and of a polygon sending it a
+    /// large share of its light only the element that sends it (not its parent, nor a piece below
+    /// it, twice); a polygon sending it little is left as it is.
+    #[test]
+    fn local_refinement_takes_the_over_polygon_and_where_its_light_comes_from() {
+        let scene = crate::scene::cornell_box();
+        let mut h = hierarchy::build(&scene, &BuildConfig::default());
+        assert!(h.subdivide(1));
+        let (a, b) = (h.children_of(1)[0], h.children_of(1)[1]);
+        assert!(h.subdivide(a));
+        let below_a = h.children_of(a)[0];
+        let radiosity = vec![[1.0; 3]; h.len()];
+        let link = |source: u32, receiver: u32, ff: f64| Link { source, receiver, ff, vis: 1.0, rays: 0 };
+        // Polygon 0 gets 0.5 from `a`, 0.3 from `below_a`, 0.02 from polygon 2; polygon 3 (not
+        // over) gets everything from `b`.
+        let links = vec![link(a, 0, 0.5), link(below_a, 0, 0.3), link(2, 0, 0.02), link(b, 3, 0.9)];
+        let mut over = vec![false; h.n_polygons as usize];
+        over[0] = true;
+        let (elements, touched) = local_refinement(&h, &links, &radiosity, &over);
+        assert_eq!(elements, vec![0, a], "the over polygon and the element sending it light");
+        let want: Vec<bool> = (0..over.len()).map(|p| p == 0 || p == 1).collect();
+        assert_eq!(touched, want);
+    }
 
     /// The levels' estimates of Ward's room (percent; the estimate rises once and then falls to the
     /// target) never stop the levels; office2's (flat from the third level on while the links grow

@@ -97,7 +97,8 @@ pub fn run(args: &CanopyBenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(args.timeout > 0.0, "--timeout must be positive");
     let exe = std::env::current_exe().context("finding the radiosity executable")?;
     let temp = std::env::temp_dir().join(format!("radiosity-bench-canopy-{}", std::process::id()));
-    let base = args.out.clone().unwrap_or_else(|| temp.clone());
+    // Absolute: each solve runs in its canopy's folder.
+    let base = std::path::absolute(args.out.clone().unwrap_or_else(|| temp.clone())).context("--out: cannot resolve the folder")?;
     let mut rows = Vec::new();
     for &n in &args.leaves {
         let dir = base.join(format!("canopy-{n}"));

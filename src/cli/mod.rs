@@ -118,8 +118,8 @@ pub struct CommonOptions {
     #[arg(long, default_value = "irradiance", value_parser = ["radiosity", "irradiance"])]
     pub criterion: String,
     /// Under a target error, refine every polygon at every level, instead of only those whose own
-    /// estimate is over half the target and the polygons that send them a tenth of their light
-    /// or more (from the third level on).
+    /// estimate is over half the target and where they get a tenth of their light or more from
+    /// (from the third level on).
     #[arg(long)]
     pub global_levels: bool,
     /// Memory refinement may use, MB (default: half the machine's physical memory): beyond it no

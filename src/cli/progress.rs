@@ -1,5 +1,5 @@
-//! Progress on the terminal: a spinner line per phase (refinement has no known total), hidden when
-//! stderr is not a terminal or with `--quiet`.
+//! Progress on the terminal: a spinner line per phase (refinement has no known total), hidden with
+//! `--quiet`; when stderr is not a terminal, a line per finished level instead.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use radiosity::pipeline::Progress;
@@ -9,11 +9,15 @@ use std::time::Duration;
 /// A progress display that may be hidden.
 pub struct Reporter {
     bar: ProgressBar,
+    /// Not a terminal and not quiet: each finished level as a line of its own (a log of a long
+    /// solve in a batch job).
+    lines: bool,
 }
 
 impl Reporter {
     /// Visible only when `!quiet` and stderr is a terminal.
     pub fn new(quiet: bool) -> Reporter {
+        let lines = !quiet && !std::io::stderr().is_terminal();
         let bar = if quiet || !std::io::stderr().is_terminal() {
             ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden())
         } else {
@@ -22,7 +26,7 @@ impl Reporter {
             bar.enable_steady_tick(Duration::from_millis(120));
             bar
         };
-        Reporter { bar }
+        Reporter { bar, lines }
     }
 
     /// Shows a phase name.
@@ -32,6 +36,11 @@ impl Reporter {
 
     /// Shows a pipeline event.
     pub fn event(&self, p: Progress) {
+        if let (true, Progress::Level { level, report }) = (self.lines, &p) {
+            let estimate = report.error_estimate.map_or(String::new(), |e| format!(", estimated error {:.2}%", 100.0 * e));
+            let refined = report.polygons_refined.map_or(String::new(), |n| format!(", {n} polygons refined further"));
+            eprintln!("level {level}: {} links{estimate}{refined} ({:.1} s)", report.links, report.time_s);
+        }
         let msg = match p {
             Progress::Refine { level, pass, links, pending } => {
                 format!("level {level}, refine pass {pass}: {links} links, {pending} candidates pending")

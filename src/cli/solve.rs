@@ -477,7 +477,10 @@ fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
             .levels
             .iter()
             .map(|l| {
-                let points = l.points_error.map_or(String::new(), |p| format!(" points {:.2}%", 100.0 * p));
+                let mut points = l.points_error.map_or(String::new(), |p| format!(" points {:.2}%", 100.0 * p));
+                if let Some(n) = l.polygons_refined {
+                    points = format!(" ({n} polygons refined){points}");
+                }
                 match l.error_estimate {
                     Some(e) => format!("{} links {:.3}s est {:.2}%{points}", l.links, l.time_s, 100.0 * e),
                     None => format!("{} links {:.3}s{points}", l.links, l.time_s),

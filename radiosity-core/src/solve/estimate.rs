@@ -64,10 +64,10 @@ impl LevelHistory {
         LevelHistory { emitting, ..LevelHistory::default() }
     }
 
-    /// Says which polygons the next level refines further (local levels, `pipeline`'s
-    /// `Config::local_levels`): a polygon left as it was keeps the change it showed the last time
-    /// it was refined as its floor ([`LevelHistory::floor_by_change`]), for a level that does not
-    /// refine its links cannot show what they miss.
+    /// Says which polygons the next level refines further for their own error (local levels,
+    /// `pipeline`'s `Config::local_levels`): any other keeps the largest change it showed since
+    /// the last level that did as its floor ([`LevelHistory::floor_by_change`]), for a level that
+    /// does not refine its links cannot show what they miss.
     pub fn refining(&mut self, refined: Vec<bool>) {
         self.refined = refined;
     }
