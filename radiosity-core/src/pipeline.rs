@@ -39,7 +39,8 @@ pub struct Config {
     /// Most levels a target error may take.
     pub max_levels: usize,
     /// Under a target error, from the third level on refine further only the polygons whose own
-    /// estimate is over [`LOCAL_SHARE_OF_TARGET`] of the target, and of the polygons that send
+    /// estimate (of their mean radiosity, or under the irradiance criterion of their mean
+    /// irradiance) is over [`LOCAL_SHARE_OF_TARGET`] of the target, and of the polygons that send
     /// one of them [`LOCAL_SOURCE_SHARE`] of its light or more the elements that send it (their
     /// links' thresholds, and their direct light's tolerance, divided by `level_step`), not every
     /// polygon. A polygon not over keeps the largest change since it last was as its estimate's
@@ -671,8 +672,9 @@ pub fn run_with_points(
         let last = level - rounds + 1 == n_levels || stats.refused_for_memory > 0;
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
+        let irradiance_errors = estimated.as_ref().map(|e| e.2.clone()).unwrap_or_default();
         // Under a target, at least what the last level changed (solve::LEVEL_CHANGE_SAFETY).
-        let estimated = estimated.map(|(e, per_polygon)| match target_error {
+        let estimated = estimated.map(|(e, per_polygon, _)| match target_error {
             Some(_) => history.floor_by_change(e, per_polygon),
             None => (e, per_polygon),
         });
@@ -806,7 +808,12 @@ pub fn run_with_points(
             break;
         }
         if local && change.is_some() {
-            let over: Vec<bool> = polygon_errors.iter().map(|&e| e > LOCAL_SHARE_OF_TARGET * target * top).collect();
+            let over: Vec<bool> = (0..polygon_errors.len())
+                .map(|p| {
+                    let share = LOCAL_SHARE_OF_TARGET * target;
+                    polygon_errors[p] > share * top || irradiance_errors.get(p).is_some_and(|&e| e > share)
+                })
+                .collect();
             // When no polygon's own estimate is over (the scene-wide terms or the irradiance of
             // black surfaces hold the whole up), every polygon is refined.
             if over.iter().any(|&o| o) {
@@ -913,6 +920,8 @@ fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link], sol: &Solu
 /// ([`crate::luminaire::direct_polygon_errors`]) is added to the mesh's, polygon by polygon
 /// ([`solve::mesh_and_direct_estimate`]): the largest of each term may lie on different
 /// polygons (on Ward's room at eps 0.64 the estimate fell from 35% to 26% for a true 7.6%).
+/// Returns the estimate, each polygon's share in W/m² of radiosity, and under the irradiance
+/// criterion each polygon's mean irradiance's share relative to the largest (empty otherwise).
 fn estimate_error(
     h: &Hierarchy,
     links: &[Link],
@@ -921,7 +930,7 @@ fn estimate_error(
     closure_changes: &[f32],
     config: &Config,
     max_bytes: usize,
-) -> (f64, Vec<f64>) {
+) -> (f64, Vec<f64>, Vec<f64>) {
     // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
     let irradiance = config.criterion == refine::Criterion::Irradiance;
     let results = crate::output::polygon_results(h, sol);
@@ -968,7 +977,23 @@ fn estimate_error(
             solve::ESTIMATE_SAFETY * (e + unresolved + reflected).max(wide) + solve::ESTIMATE_FLOOR * top
         })
         .collect();
-    (estimate, per_polygon)
+    // Under the irradiance criterion, each polygon's mean irradiance's own share (relative to the
+    // largest measured mean irradiance): what black and dark surfaces hold the estimate up by.
+    let irradiance_errors = if irradiance {
+        let measured = |p: usize| h.emission[p].iter().all(|&x| x <= 0.0);
+        let top = (0..h_means[0].len()).filter(|&p| measured(p)).flat_map(|p| h_means[0][p]).fold(0.0, f64::max);
+        solve::richardson_per_polygon(&h_means[0], &h_means[1], &h_means[2])
+            .into_iter()
+            .enumerate()
+            .map(|(p, e)| {
+                let direct = direct_errors.get(p).map_or(0.0, |d| d.iter().copied().fold(0.0, f64::max));
+                if measured(p) && top > 0.0 { solve::ESTIMATE_SAFETY * (e + direct) / top } else { 0.0 }
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    (estimate, per_polygon, irradiance_errors)
 }
 
 /// What a local level refines further: each polygon of `over` whole, and of every polygon that
