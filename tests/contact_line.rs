@@ -147,7 +147,10 @@ fn worst_floor_error(criterion: Criterion) -> Worst {
     std::fs::write(dir.path().join("blk.obj"), scene_obj()).unwrap();
     std::fs::write(dir.path().join("blk.mtl"), MTL).unwrap();
     let scene = radiosity::scene::load(&dir.path().join("blk.obj"), &Default::default()).expect("the scene loads");
-    let config = Config { target_error: Some(0.01), criterion, ..Config::default() };
+    // Global levels: the bar is on elements, which the target (on polygon means) does not bound;
+    // local levels leave the floor as it is once its mean meets the target, and its worst element
+    // beside the block was then 3.67% off (2026-12-06).
+    let config = Config { target_error: Some(0.01), criterion, local_levels: false, ..Config::default() };
     let solved = pipeline::run(&scene, &BfHand::default(), &config, &|_| {});
     let h = &solved.hierarchy;
     let floor: Vec<u32> = h
