@@ -672,9 +672,12 @@ pub fn run_with_points(
         let last = level - rounds + 1 == n_levels || stats.refused_for_memory > 0;
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(&h, &links, &sol, closed, &closure_changes, config, leaf_budget));
-        let irradiance_errors = estimated.as_ref().map(|e| e.2.clone()).unwrap_or_default();
+        let (estimated, irradiance_errors) = match estimated {
+            Some((e, per_polygon, irradiance)) => (Some((e, per_polygon)), irradiance),
+            None => (None, Vec::new()),
+        };
         // Under a target, at least what the last level changed (solve::LEVEL_CHANGE_SAFETY).
-        let estimated = estimated.map(|(e, per_polygon, _)| match target_error {
+        let estimated = estimated.map(|(e, per_polygon)| match target_error {
             Some(_) => history.floor_by_change(e, per_polygon),
             None => (e, per_polygon),
         });
@@ -808,11 +811,9 @@ pub fn run_with_points(
             break;
         }
         if local && change.is_some() {
+            let share = LOCAL_SHARE_OF_TARGET * target;
             let over: Vec<bool> = (0..polygon_errors.len())
-                .map(|p| {
-                    let share = LOCAL_SHARE_OF_TARGET * target;
-                    polygon_errors[p] > share * top || irradiance_errors.get(p).is_some_and(|&e| e > share)
-                })
+                .map(|p| polygon_errors[p] > share * top || irradiance_errors.get(p).is_some_and(|&e| e > share))
                 .collect();
             // When no polygon's own estimate is over (the scene-wide terms or the irradiance of
             // black surfaces hold the whole up), every polygon is refined.
@@ -980,16 +981,14 @@ fn estimate_error(
     // Under the irradiance criterion, each polygon's mean irradiance's own share (relative to the
     // largest measured mean irradiance): what black and dark surfaces hold the estimate up by.
     let irradiance_errors = if irradiance {
-        let measured = |p: usize| h.emission[p].iter().all(|&x| x <= 0.0);
-        let top = (0..h_means[0].len()).filter(|&p| measured(p)).flat_map(|p| h_means[0][p]).fold(0.0, f64::max);
-        solve::richardson_per_polygon(&h_means[0], &h_means[1], &h_means[2])
-            .into_iter()
-            .enumerate()
-            .map(|(p, e)| {
-                let direct = direct_errors.get(p).map_or(0.0, |d| d.iter().copied().fold(0.0, f64::max));
-                if measured(p) && top > 0.0 { solve::ESTIMATE_SAFETY * (e + direct) / top } else { 0.0 }
-            })
-            .collect()
+        let top = solve::measured_polygons(h).flat_map(|p| h_means[0][p]).fold(0.0, f64::max);
+        let own = solve::richardson_per_polygon(&h_means[0], &h_means[1], &h_means[2]);
+        let mut errors = vec![0.0; own.len()];
+        for p in solve::measured_polygons(h).filter(|_| top > 0.0) {
+            let direct = direct_errors.get(p).map_or(0.0, |d| d.iter().copied().fold(0.0, f64::max));
+            errors[p] = solve::ESTIMATE_SAFETY * (own[p] + direct) / top;
+        }
+        errors
     } else {
         Vec::new()
     };

@@ -302,7 +302,7 @@ fn worst_relative(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], error
 
 /// The polygons the estimate measures: the non-emitting ones (every polygon in a furnace, where
 /// all emit).
-fn measured_polygons(h: &crate::hierarchy::Hierarchy) -> impl Iterator<Item = usize> + '_ {
+pub(crate) fn measured_polygons(h: &crate::hierarchy::Hierarchy) -> impl Iterator<Item = usize> + '_ {
     let emits = |p: usize| h.emission[p].iter().any(|&x| x > 0.0);
     let all = (0..h.n_polygons as usize).all(emits);
     (0..h.n_polygons as usize).filter(move |&p| all || !emits(p))
