@@ -214,10 +214,22 @@ pub fn visibility_noise(
     radiosity: &[[f64; 3]],
     irradiance: Option<&[[f64; 3]]>,
 ) -> f64 {
-    let sd = irradiance_noise(h, links, radiosity);
-    let of_radiosity = worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * sd[p][c]);
-    let of_irradiance = irradiance.map_or(0.0, |means| worst_relative(h, means, |p, c| sd[p][c]));
-    NOISE_SIGMAS * of_radiosity.max(of_irradiance)
+    worst_noise(h, &noise_per_polygon(h, links, radiosity), radiosity, irradiance)
+}
+
+/// [`NOISE_SIGMAS`] standard deviations of each polygon's mean irradiance from visibility
+/// sampling, per channel, in W/m² (what [`visibility_noise`] takes the largest of).
+#[must_use]
+pub fn noise_per_polygon(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    irradiance_noise(h, links, radiosity).into_iter().map(|sd| sd.map(|x| NOISE_SIGMAS * x)).collect()
+}
+
+/// [`visibility_noise`] from the polygons' noise ([`noise_per_polygon`]).
+#[must_use]
+pub fn worst_noise(h: &crate::hierarchy::Hierarchy, noise: &[[f64; 3]], radiosity: &[[f64; 3]], irradiance: Option<&[[f64; 3]]>) -> f64 {
+    let of_radiosity = worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * noise[p][c]);
+    let of_irradiance = irradiance.map_or(0.0, |means| worst_relative(h, means, |p, c| noise[p][c]));
+    of_radiosity.max(of_irradiance)
 }
 
 /// The error the closure of a closed scene may leave ([`super::LeafCoefficients::closure`]): it

@@ -18,8 +18,8 @@ pub use direct::{direct_irradiance, direct_lower_bound, emitter_exchange};
 pub(crate) use estimate::measured_polygons;
 pub use estimate::{
     CHANGE_FACTOR_MAX, ESTIMATE_FLOOR, ESTIMATE_SAFETY, LEVEL_CHANGE_SAFETY, LevelHistory, NOISE_SIGMAS, ORDER_MAX, ORDER_MIN,
-    closure_error, largest_non_emitting_mean, mesh_and_direct_estimate, richardson_estimate, richardson_per_polygon,
-    unresolved_per_polygon, visibility_noise,
+    closure_error, largest_non_emitting_mean, mesh_and_direct_estimate, noise_per_polygon, richardson_estimate, richardson_per_polygon,
+    unresolved_per_polygon, visibility_noise, worst_noise,
 };
 pub use final_gather::{area_means, final_gather, top_down};
 pub use gmres::{GmresResult, gmres};
