@@ -812,8 +812,10 @@ pub fn run_with_points(
         }
         if local && change.is_some() {
             let share = LOCAL_SHARE_OF_TARGET * target;
-            let over: Vec<bool> = (0..polygon_errors.len())
-                .map(|p| polygon_errors[p] > share * top || irradiance_errors.get(p).is_some_and(|&e| e > share))
+            let over: Vec<bool> = polygon_errors
+                .iter()
+                .enumerate()
+                .map(|(p, &e)| e > share * top || irradiance_errors.get(p).is_some_and(|&e| e > share))
                 .collect();
             // When no polygon's own estimate is over (the scene-wide terms or the irradiance of
             // black surfaces hold the whole up), every polygon is refined.
@@ -978,22 +980,23 @@ fn estimate_error(
         .into_iter()
         .enumerate()
         .map(|(p, e)| {
-            let reflected = direct_errors.get(p).map_or(0.0, |d| (0..3).map(|c| h.reflectance[p][c] * d[c]).fold(0.0, f64::max));
+            // Irradiance errors passed on as radiosity, largest channel.
+            let reflected = |v: [f64; 3]| (0..3).map(|c| h.reflectance[p][c] * v[c]).fold(0.0, f64::max);
+            let direct = direct_errors.get(p).map_or(0.0, |&d| reflected(d));
             let unresolved = unresolved[p].into_iter().fold(0.0, f64::max);
-            let noise = (0..3).map(|c| h.reflectance[p][c] * polygon_noise[p][c]).fold(0.0, f64::max);
-            solve::ESTIMATE_SAFETY * (e + unresolved + reflected).max(noise).max(wide) + solve::ESTIMATE_FLOOR * top
+            solve::ESTIMATE_SAFETY * (e + unresolved + direct).max(reflected(polygon_noise[p])).max(wide) + solve::ESTIMATE_FLOOR * top
         })
         .collect();
     // Under the irradiance criterion, each polygon's mean irradiance's own share (relative to the
     // largest measured mean irradiance): what black and dark surfaces hold the estimate up by.
     let irradiance_errors = if irradiance {
-        let top = solve::measured_polygons(h).flat_map(|p| h_means[0][p]).fold(0.0, f64::max);
+        let top_h = solve::measured_polygons(h).flat_map(|p| h_means[0][p]).fold(0.0, f64::max);
         let own = solve::richardson_per_polygon(&h_means[0], &h_means[1], &h_means[2]);
         let mut errors = vec![0.0; own.len()];
-        for p in solve::measured_polygons(h).filter(|_| top > 0.0) {
+        for p in solve::measured_polygons(h).filter(|_| top_h > 0.0) {
             let direct = direct_errors.get(p).map_or(0.0, |d| d.iter().copied().fold(0.0, f64::max));
             let noise = polygon_noise[p].into_iter().fold(0.0, f64::max);
-            errors[p] = solve::ESTIMATE_SAFETY * (own[p] + direct).max(noise) / top;
+            errors[p] = solve::ESTIMATE_SAFETY * (own[p] + direct).max(noise) / top_h;
         }
         errors
     } else {
@@ -1019,15 +1022,13 @@ fn local_refinement(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]], over:
         total[p as usize] += power;
         *from.entry((p, q)).or_default() += power;
     }
-    let strong: std::collections::BTreeSet<(u32, u32)> =
-        from.into_iter().filter(|&((p, _), power)| power >= LOCAL_SOURCE_SHARE * total[p as usize]).map(|(k, _)| k).collect();
     let mut marked = vec![false; h.len()];
     for p in (0..n).filter(|&p| over[p]) {
         marked[p] = true;
     }
     for l in links {
         let (Some(p), Some(q)) = (h.get(l.receiver).polygon(), h.get(l.source).polygon()) else { continue };
-        if strong.contains(&(p, q)) {
+        if from.get(&(p, q)).is_some_and(|&power| power >= LOCAL_SOURCE_SHARE * total[p as usize]) {
             marked[l.source as usize] = true;
         }
     }

@@ -221,7 +221,21 @@ pub fn visibility_noise(
 /// sampling, per channel, in W/m² (what [`visibility_noise`] takes the largest of).
 #[must_use]
 pub fn noise_per_polygon(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
-    irradiance_noise(h, links, radiosity).into_iter().map(|sd| sd.map(|x| NOISE_SIGMAS * x)).collect()
+    let n = h.n_polygons as usize;
+    let mut var = vec![[0.0; 3]; n];
+    for l in links {
+        if l.vis <= 0.0 || l.vis >= 1.0 {
+            continue;
+        }
+        let sd = (l.vis * (1.0 - l.vis) / f64::from(l.rays.max(1))).sqrt() * l.ff;
+        let b = radiosity[l.source as usize];
+        receiver_polygons(h, l.receiver, |p, share| {
+            for c in 0..3 {
+                var[p][c] += (share * sd * b[c]).powi(2);
+            }
+        });
+    }
+    var.into_iter().map(|v| v.map(|x| NOISE_SIGMAS * x.sqrt())).collect()
 }
 
 /// [`visibility_noise`] from the polygons' noise ([`noise_per_polygon`]).
@@ -268,26 +282,6 @@ pub fn closure_error(
     let of_radiosity = worst_relative(h, radiosity, |p, c| h.reflectance[p][c] * moved[p][c]);
     let of_irradiance = irradiance.map_or(0.0, |means| worst_relative(h, means, |p, c| moved[p][c]));
     of_radiosity.max(of_irradiance)
-}
-
-/// One standard deviation of each polygon's mean irradiance from visibility sampling (see
-/// [`visibility_noise`]).
-fn irradiance_noise(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
-    let n = h.n_polygons as usize;
-    let mut var = vec![[0.0; 3]; n];
-    for l in links {
-        if l.vis <= 0.0 || l.vis >= 1.0 {
-            continue;
-        }
-        let sd = (l.vis * (1.0 - l.vis) / f64::from(l.rays.max(1))).sqrt() * l.ff;
-        let b = radiosity[l.source as usize];
-        receiver_polygons(h, l.receiver, |p, share| {
-            for c in 0..3 {
-                var[p][c] += (share * sd * b[c]).powi(2);
-            }
-        });
-    }
-    var.into_iter().map(|v| v.map(f64::sqrt)).collect()
 }
 
 /// Calls `add(polygon, share)` for every polygon a link's `receiver` covers: a surface's own with
