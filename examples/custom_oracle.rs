@@ -11,7 +11,12 @@ use radiosity::refine::{BfHand, LinkCtx};
 
 radiosity::answer_enum! {
     /// How far apart the two elements are, relative to their sizes.
-    pub enum Separation { Near, Far }
+    pub enum Separation {
+        /// Nearer than the threshold: subdivide.
+        Near,
+        /// Far enough to link.
+        Far,
+    }
 }
 
 /// A custom tool: is the centre distance above `factor` times the sum of the bounding radii?

@@ -349,7 +349,7 @@ fn generated_tree_under_daylight_reports_absorbed_par_and_nir() {
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
     let (mat, par, nir) = (col("material"), col("absorbed_PAR"), col("absorbed_NIR"));
     let leaves: Vec<Vec<&str>> = patches.lines().skip(1).map(|l| l.split(',').collect::<Vec<_>>()).filter(|r| r[mat] == "leaf").collect();
-    assert!(leaves.len() > 100 && leaves.len() % 2 == 0, "{} leaf sides", leaves.len());
+    assert!(leaves.len() > 100 && leaves.len().is_multiple_of(2), "{} leaf sides", leaves.len());
     // Leaves absorb most of the PAR and scatter most of the NIR that reaches them.
     let sum = |k: usize| leaves.iter().map(|r| r[k].parse::<f64>().unwrap()).sum::<f64>();
     assert!(sum(par) > 2.0 * sum(nir), "leaves absorbed PAR {} NIR {}", sum(par), sum(nir));

@@ -12,7 +12,6 @@
 //! - [`points`]: irradiance at calculation points, gathered from the solution → `points.csv`
 //! - [`canopy`]: random canopies of black leaves for validation against Beer's law
 //! - [`photometry`]: luminous intensity distributions of luminaires (IES LM-63, EULUMDAT)
-#![warn(missing_docs)]
 
 pub mod analysis;
 pub mod canopy;

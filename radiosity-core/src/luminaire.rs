@@ -171,7 +171,7 @@ fn smaller_shadow_falls_on(h: &Hierarchy, id: u32, toward: DVec3, occluders: &cr
     let n = e.normal;
     let own = poly.vertices();
     let mut found = false;
-    for_each_shadow(h, &poly, n, polygon, toward, occluders, |shadow| {
+    for_each_shadow(h, poly, n, polygon, toward, occluders, |shadow| {
         let centre = shadow.iter().copied().sum::<DVec3>() / shadow.len() as f64;
         let radius = shadow.iter().map(|&v| (v - centre).length()).fold(0.0, f64::max);
         // Small, or thin: a leaf seen edge-on casts a sliver longer than the element and
@@ -449,6 +449,7 @@ pub fn deepen_direct(h: &mut Hierarchy, lights: &Lights, caster: Option<&RayCast
 /// the rule's, with no error. The soft sources' light is `inherited` where given (its parent's,
 /// seen the same all over it), and comes back where the leaf's pieces may take it
 /// ([`Hierarchy::direct_soft`]).
+#[expect(clippy::too_many_arguments, reason = "the element, its sources and its quadrature, each read by the rule")]
 fn leaf_direct(
     poly: &crate::geom::Poly,
     normal: DVec3,
@@ -503,6 +504,7 @@ fn pieces_direct(
 /// and whether the rule may be inaccurate: a shadow boundary of a luminaire crosses the element
 /// (its points or corners disagree on the luminaire's visibility), or a luminaire that lights it
 /// is nearer than [`MAX_ANGULAR_SIZE`] allows.
+#[expect(clippy::too_many_arguments, reason = "the element, its sources and its quadrature, each read by the rule")]
 fn rule_direct(
     poly: &crate::geom::Poly,
     normal: DVec3,

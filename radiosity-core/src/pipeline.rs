@@ -1099,6 +1099,7 @@ fn direct_tolerance(target: Option<f64>, scale: f64) -> Option<f64> {
 /// the edge, [`crate::hierarchy::Hierarchy::direct_edge`]); on an 800-leaf canopy a quarter fewer
 /// elements at the same accuracy. Returns how many leaves were split (their children inherit
 /// `data`). Nothing without a tolerance (a target error, [`direct_tolerance`]).
+#[expect(clippy::too_many_arguments, reason = "the pipeline's state this step reads and writes, passed explicitly")]
 fn refine_direct(
     h: &mut Hierarchy,
     data: &mut ElementData,

@@ -65,6 +65,20 @@ pub const TRI_6: Rule = Rule {
     weights: &[T6WA, T6WA, T6WA, T6WB, T6WB, T6WB],
 };
 
+/// The points of `rule` on `poly` with their weights: the rule's weights times the local Jacobian
+/// of the bilinear map on quads (so non-parallelograms integrate correctly), the rule's weights on
+/// triangles. Divide by the weights' sum for a mean.
+pub fn weighted_points<'a>(poly: &'a crate::geom::Poly, rule: &'a Rule) -> impl Iterator<Item = (glam::DVec3, f64)> + 'a {
+    rule.points.iter().zip(rule.weights).map(move |(&(u, v), &w)| match poly.kind {
+        crate::geom::PolyKind::Quad => {
+            let du = (1.0 - v) * (poly.v[1] - poly.v[0]) + v * (poly.v[2] - poly.v[3]);
+            let dv = (1.0 - u) * (poly.v[3] - poly.v[0]) + u * (poly.v[2] - poly.v[1]);
+            (poly.point(u, v), w * du.cross(dv).length())
+        }
+        crate::geom::PolyKind::Triangle => (poly.point(u, v), w),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,18 +99,4 @@ mod tests {
         let got: f64 = TRI_6.points.iter().zip(TRI_6.weights).map(|(&(s, t), w)| w * s * s * t * t).sum();
         assert!((got - exact).abs() < 1e-10, "{got} vs {exact}");
     }
-}
-
-/// The points of `rule` on `poly` with their weights: the rule's weights times the local Jacobian
-/// of the bilinear map on quads (so non-parallelograms integrate correctly), the rule's weights on
-/// triangles. Divide by the weights' sum for a mean.
-pub fn weighted_points<'a>(poly: &'a crate::geom::Poly, rule: &'a Rule) -> impl Iterator<Item = (glam::DVec3, f64)> + 'a {
-    rule.points.iter().zip(rule.weights).map(move |(&(u, v), &w)| match poly.kind {
-        crate::geom::PolyKind::Quad => {
-            let du = (1.0 - v) * (poly.v[1] - poly.v[0]) + v * (poly.v[2] - poly.v[3]);
-            let dv = (1.0 - u) * (poly.v[3] - poly.v[0]) + u * (poly.v[2] - poly.v[1]);
-            (poly.point(u, v), w * du.cross(dv).length())
-        }
-        crate::geom::PolyKind::Triangle => (poly.point(u, v), w),
-    })
 }

@@ -435,9 +435,7 @@ mod tests {
         b.face(&[c(3., 0., 0.), c(4., 0., 0.), c(3.5, 1., 0.5)], m, g, 0).unwrap();
         let mut scene = b.finish();
         scene.pair_two_sided();
-        let mut config = BuildConfig::default();
-        config.min_area_rel = 1e-4;
-        build(&scene, &config)
+        build(&scene, &BuildConfig { min_area_rel: 1e-4, ..BuildConfig::default() })
     }
 
     /// A 10 cm leaf over a 10 m ground: the smallest element relative to the scene (2e-6 of its

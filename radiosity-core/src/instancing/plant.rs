@@ -332,6 +332,43 @@ pub fn generate_forest(params: &ForestParams) -> InstancedScene {
     lib.finish(root)
 }
 
+/// Splits every quad of material `material` among the own polygons of prototype `id` into tiles
+/// at most `size` a side (bilinearly, so a parallelogram gives equal parallelograms), in place of
+/// the quad. For a scene under the sun and sky: the instanced solve lights each top-level polygon
+/// by its mean over its points, uniformly inside it, so a ground in one piece would be as bright
+/// under the trees as in the open. Returns how many tiles replaced how many quads.
+pub fn tile_quads(scene: &mut InstancedScene, id: PrototypeId, material: u32, size: f64) -> (usize, usize) {
+    let Some(p) = scene.prototypes.get_mut(id as usize) else { return (0, 0) };
+    if !(size > 0.0 && size.is_finite()) {
+        return (0, 0);
+    }
+    let (mut tiles, mut quads) = (0, 0);
+    let mut out = Vec::with_capacity(p.polygons.len());
+    for q in p.polygons.drain(..) {
+        let v = q.poly.vertices();
+        if q.material != material || v.len() != 4 {
+            out.push(q);
+            continue;
+        }
+        let (a, b, c, d) = (v[0], v[1], v[2], v[3]);
+        let nu = (((b - a).length().max((c - d).length())) / size).ceil().max(1.0) as usize;
+        let nv = (((d - a).length().max((c - b).length())) / size).ceil().max(1.0) as usize;
+        let at = |i: usize, j: usize| {
+            let (u, w) = (i as f64 / nu as f64, j as f64 / nv as f64);
+            a * ((1.0 - u) * (1.0 - w)) + b * (u * (1.0 - w)) + c * (u * w) + d * ((1.0 - u) * w)
+        };
+        for j in 0..nv {
+            for i in 0..nu {
+                out.push(LocalPolygon { poly: Poly::quad(at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)), material });
+            }
+        }
+        tiles += nu * nv;
+        quads += 1;
+    }
+    p.polygons = out;
+    (tiles, quads)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -376,41 +413,4 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), t.prototypes.len());
     }
-}
-
-/// Splits every quad of material `material` among the own polygons of prototype `id` into tiles
-/// at most `size` a side (bilinearly, so a parallelogram gives equal parallelograms), in place of
-/// the quad. For a scene under the sun and sky: the instanced solve lights each top-level polygon
-/// by its mean over its points, uniformly inside it, so a ground in one piece would be as bright
-/// under the trees as in the open. Returns how many tiles replaced how many quads.
-pub fn tile_quads(scene: &mut InstancedScene, id: PrototypeId, material: u32, size: f64) -> (usize, usize) {
-    let Some(p) = scene.prototypes.get_mut(id as usize) else { return (0, 0) };
-    if !(size > 0.0 && size.is_finite()) {
-        return (0, 0);
-    }
-    let (mut tiles, mut quads) = (0, 0);
-    let mut out = Vec::with_capacity(p.polygons.len());
-    for q in p.polygons.drain(..) {
-        let v = q.poly.vertices();
-        if q.material != material || v.len() != 4 {
-            out.push(q);
-            continue;
-        }
-        let (a, b, c, d) = (v[0], v[1], v[2], v[3]);
-        let nu = (((b - a).length().max((c - d).length())) / size).ceil().max(1.0) as usize;
-        let nv = (((d - a).length().max((c - b).length())) / size).ceil().max(1.0) as usize;
-        let at = |i: usize, j: usize| {
-            let (u, w) = (i as f64 / nu as f64, j as f64 / nv as f64);
-            a * ((1.0 - u) * (1.0 - w)) + b * (u * (1.0 - w)) + c * (u * w) + d * ((1.0 - u) * w)
-        };
-        for j in 0..nv {
-            for i in 0..nu {
-                out.push(LocalPolygon { poly: Poly::quad(at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)), material });
-            }
-        }
-        tiles += nu * nv;
-        quads += 1;
-    }
-    p.polygons = out;
-    (tiles, quads)
 }

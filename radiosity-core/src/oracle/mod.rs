@@ -46,7 +46,12 @@ pub trait Answer: Copy {
 /// ```
 /// radiosity_core::answer_enum! {
 ///     /// Is it bright?
-///     pub enum Bright { Yes, No }
+///     pub enum Bright {
+///         /// Brighter than the threshold.
+///         Yes,
+///         /// Not brighter.
+///         No,
+///     }
 /// }
 /// ```
 #[macro_export]

@@ -147,10 +147,7 @@ impl GlbLayout {
                 roughness_factor: json::material::StrengthFactor(1.0),
                 ..Default::default()
             },
-            extensions: Some(json::extensions::material::Material {
-                unlit: Some(json::extensions::material::Unlit {}),
-                ..Default::default()
-            }),
+            extensions: Some(json::extensions::material::Material { unlit: Some(json::extensions::material::Unlit {}) }),
             ..Default::default()
         });
         root.extensions_used.push("KHR_materials_unlit".into());
@@ -181,10 +178,16 @@ impl GlbLayout {
     }
 }
 
+/// A leaf's vertices and its corner values.
+type LeafCorners = (Vec<[f32; 3]>, [[f64; 3]; 4]);
+
+/// Writes one value per vertex into the buffer of a section: its position and its corner value.
+type VertexWriter<'a> = dyn FnMut(&mut Vec<u8>, &[f32; 3], [f64; 3]) + 'a;
+
 /// Writes the leaves of `h` as `solution.glb` (see the module docs): the vertices and corner
 /// values of [`super::write_ply`], colours from `tone`.
 pub fn write_glb(w: &mut impl Write, h: &Hierarchy, corners: &CornerValues, tone: &ToneMap) -> std::io::Result<()> {
-    let leaves: Vec<(Vec<[f32; 3]>, [[f64; 3]; 4])> = h
+    let leaves: Vec<LeafCorners> = h
         .leaves()
         .filter_map(|e| {
             let poly = h.get(e).poly()?;
@@ -208,7 +211,7 @@ pub fn write_glb(w: &mut impl Write, h: &Hierarchy, corners: &CornerValues, tone
     let layout = GlbLayout { n_vertices: n_vertices as u64, n_triangles: n_triangles as u64, min, max };
     w.write_all(&layout.header()?)?;
     let mut buf = Vec::with_capacity(12 * n_vertices);
-    let mut section = |w: &mut dyn Write, f: &mut dyn FnMut(&mut Vec<u8>, &[f32; 3], [f64; 3])| {
+    let mut section = |w: &mut dyn Write, f: &mut VertexWriter<'_>| {
         buf.clear();
         for (vs, c) in &leaves {
             for (k, v) in vs.iter().enumerate() {

@@ -205,13 +205,7 @@ mod tests {
         assert!(below.len() >= 9, "two levels below the root: {}", below.len());
         let deepest = h.children_of(child)[0];
         for &e in &below {
-            let want = if e == deepest {
-                0.125
-            } else if e == 0 || e == child {
-                0.125
-            } else {
-                0.25
-            };
+            let want = if e == deepest || e == 0 || e == child { 0.125 } else { 0.25 };
             assert!((data.importance[e as usize] - want).abs() < 1e-12, "element {e}: {}", data.importance[e as usize]);
         }
         let root = h.root as usize;

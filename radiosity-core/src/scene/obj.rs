@@ -206,10 +206,10 @@ fn prescan_mtl(text: &str, path: &Path) -> Result<(), SceneError> {
                 Some(w) => return Err(err(line_no, format!("`illum` value `{w}` is not an illumination model (0 to 255)"))),
                 None => return Err(err(line_no, "`illum` needs an illumination model".to_owned())),
             },
-            "newmtl" | "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns" | "map_NS" | "bump" | "map_d" => {
-                if words.next().is_none() {
-                    return Err(err(line_no, format!("`{key}` needs a name")));
-                }
+            "newmtl" | "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns" | "map_NS" | "bump" | "map_d"
+                if words.next().is_none() =>
+            {
+                return Err(err(line_no, format!("`{key}` needs a name")));
             }
             _ => {}
         }
