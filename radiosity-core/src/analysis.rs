@@ -19,6 +19,11 @@ pub struct SceneTraits {
     pub coloured: bool,
     /// Some material is two-sided or transmits light.
     pub two_sided: bool,
+    /// Polygons that can send no light: they neither emit, reflect nor transmit in any channel.
+    /// The refinement makes no link from them (their radiosity is zero whatever they receive).
+    pub dark_polygons: usize,
+    /// Polygons in all.
+    pub polygons: usize,
 }
 
 impl SceneTraits {
@@ -30,7 +35,11 @@ impl SceneTraits {
             ch(m.reflectance) || ch(m.emission)
         });
         let two_sided = scene.materials.iter().any(|m| m.two_sided || m.transmittance.iter().any(|&t| t > 0.0));
-        SceneTraits { needs_visibility: !is_convex_enclosure(scene), coloured, two_sided }
+        let positive = |v: &[f64; 3]| v.iter().any(|&x| x > 0.0);
+        let dark: Vec<bool> =
+            scene.materials.iter().map(|m| !(positive(&m.emission) || positive(&m.reflectance) || positive(&m.transmittance))).collect();
+        let dark_polygons = scene.polygons.iter().filter(|p| dark.get(p.material as usize).copied().unwrap_or(false)).count();
+        SceneTraits { needs_visibility: !is_convex_enclosure(scene), coloured, two_sided, dark_polygons, polygons: scene.polygons.len() }
     }
 
     /// The machinery a solve leaves out for this scene, in words (for the console and `stats.json`).
@@ -39,6 +48,14 @@ impl SceneTraits {
         let mut out = Vec::new();
         if !self.needs_visibility {
             out.push("visibility rays (convex enclosure: no polygon can occlude another)".to_string());
+        }
+        if self.polygons > 0 && self.dark_polygons == self.polygons {
+            out.push("links (no surface emits, reflects or transmits light: the direct light is the whole answer)".to_string());
+        } else if self.dark_polygons > 0 {
+            out.push(format!(
+                "links from {} of {} polygons (black and not emitting: they send no light)",
+                self.dark_polygons, self.polygons
+            ));
         }
         out
     }
@@ -72,5 +89,21 @@ mod tests {
         let t = SceneTraits::of(&cornell);
         assert!(t.needs_visibility && t.coloured && !t.two_sided);
         assert!(t.left_out().is_empty());
+    }
+
+    #[test]
+    fn black_polygons_are_left_out_as_sources() {
+        let mut scene = crate::scene::cornell_box();
+        let n = scene.polygons.len();
+        scene.materials.push(crate::scene::Material::diffuse("black", [0.0; 3]));
+        let black = (scene.materials.len() - 1) as u32;
+        scene.polygons[0].material = black;
+        let t = SceneTraits::of(&scene);
+        assert_eq!((t.dark_polygons, t.polygons), (1, n));
+        assert_eq!(t.left_out(), vec![format!("links from 1 of {n} polygons (black and not emitting: they send no light)")]);
+        for p in &mut scene.polygons {
+            p.material = black;
+        }
+        assert!(SceneTraits::of(&scene).left_out()[0].starts_with("links (no surface emits"));
     }
 }

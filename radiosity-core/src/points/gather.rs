@@ -197,6 +197,11 @@ pub struct PointGather<'a> {
     /// non-emitting polygon mean it is relative to; NaN when unknown (until
     /// [`PointGather::for_solved`] sets it from an estimated solve).
     mean_error: f64,
+    /// The input polygons' boxes, each grown by as much as the on-surface test may reach beyond
+    /// the polygon ([`on_surface_reach`]): a point finds the surfaces it lies on among the few
+    /// boxes holding it, not by testing every polygon (on a canopy of 320,000 leaf sides that
+    /// test was two thirds of the solve).
+    on_surface: crate::visibility::shaft::ObjectBvh,
 }
 
 impl<'a> PointGather<'a> {
@@ -228,15 +233,26 @@ impl<'a> PointGather<'a> {
                 })
             })
             .collect();
+        let scale = bounds.diagonal();
+        let tol = ON_SURFACE_REL_TOL * scale;
+        let boxes: Vec<Aabb> = (0..h.n_polygons)
+            .map(|p| {
+                let e = h.get(p);
+                let b = e.bounds;
+                let reach = e.poly().map_or(0.0, |poly| on_surface_reach(poly, tol, scale));
+                Aabb { min: b.min - DVec3::splat(reach), max: b.max + DVec3::splat(reach) }
+            })
+            .collect();
         PointGather {
             h,
             caster: caster.filter(|_| config.use_visibility),
             sources,
-            scale: bounds.diagonal(),
+            scale,
             convex_enclosure: false,
             shadow_depth: config.shadow_depth,
             lights: None,
             mean_error: f64::NAN,
+            on_surface: crate::visibility::shaft::ObjectBvh::build(&boxes),
         }
     }
 
@@ -320,12 +336,20 @@ impl<'a> PointGather<'a> {
         // every surface it lies on (its front side unless the receiver faces the back).
         let mut sides = Sides { x, normals: [n; MAX_SIDES], len: 1 };
         let mut offset = n;
-        let mut inside = true;
-        for p in 0..self.h.n_polygons {
+        // Inside a convex enclosure: in front of every polygon's plane.
+        let inside = self.convex_enclosure
+            && (0..self.h.n_polygons).all(|p| {
+                let e = self.h.get(p);
+                e.poly().is_none_or(|poly| e.normal.dot(x - poly.v[0]) >= -tol)
+            });
+        // The polygons whose grown boxes hold the point, in input order (as the sides are added).
+        let mut near: Vec<u32> = Vec::new();
+        self.on_surface.traverse(|b| (0..3).all(|k| b.min[k] <= x[k] && x[k] <= b.max[k]), |p| near.push(p));
+        near.sort_unstable();
+        for p in near {
             let e = self.h.get(p);
             let Some(poly) = e.poly() else { continue };
             let height = e.normal.dot(x - poly.v[0]);
-            inside &= height >= -tol;
             if height.abs() <= tol && contains(poly, e.normal, x, tol) {
                 let side = if n.dot(e.normal) >= 0.0 { e.normal } else { -e.normal };
                 if sides.add(side) {
@@ -473,6 +497,23 @@ pub const SKY_ERROR_FACTOR: f64 = 1.5;
 
 /// Whether `x` (near the plane of `poly`, unit normal `normal`) lies within `tol` of the polygon's
 /// area: inside every edge, or no farther than `tol` outside it.
+/// How far beyond its own box a point may lie and still be on polygon `poly` for
+/// [`contains`] with `tol` and a height within `tol`: the region within `tol` outside each edge
+/// line reaches past a corner of interior angle `θ` by `tol / sin(θ/2)`. At most `scale` (a
+/// degenerate corner: every point is tested).
+fn on_surface_reach(poly: &Poly, tol: f64, scale: f64) -> f64 {
+    let vs = poly.vertices();
+    let n = vs.len();
+    let corner = (0..n)
+        .map(|k| {
+            let (a, b) = ((vs[(k + n - 1) % n] - vs[k]).normalize_or_zero(), (vs[(k + 1) % n] - vs[k]).normalize_or_zero());
+            let half_sin = (0.5 * (1.0 - a.dot(b))).max(0.0).sqrt();
+            if half_sin > 0.0 { (tol / half_sin).min(scale) } else { scale }
+        })
+        .fold(0.0, f64::max);
+    2.0 * tol + corner
+}
+
 fn contains(poly: &Poly, normal: DVec3, x: DVec3, tol: f64) -> bool {
     let vs = poly.vertices();
     (0..vs.len()).all(|k| {
