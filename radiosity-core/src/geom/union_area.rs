@@ -50,17 +50,7 @@ pub fn clip_convex(subject: &[Point2], window: &[Point2]) -> Vec<Point2> {
         // Positive on the window's side (left of the edge).
         let side = |p: Point2| cross(edge, [p[0] - a[0], p[1] - a[1]]);
         let input = std::mem::take(&mut out);
-        for k in 0..input.len() {
-            let (p, q) = (input[k], input[(k + 1) % input.len()]);
-            let (sp, sq) = (side(p), side(q));
-            if sp >= 0.0 {
-                out.push(p);
-            }
-            if (sp >= 0.0) != (sq >= 0.0) {
-                let t = sp / (sp - sq);
-                out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
-            }
-        }
+        clip_side(&input, side, |x| x, &mut out);
     }
     if out.len() < 3 { Vec::new() } else { out }
 }
@@ -124,21 +114,33 @@ fn split_area(polys: Vec<Vec<Point2>>) -> f64 {
 fn clip_half(p: &[Point2], axis: usize, at: f64, keep_above: bool) -> Vec<Point2> {
     let side = |v: Point2| if keep_above { v[axis] - at } else { at - v[axis] };
     let mut out = Vec::with_capacity(p.len() + 1);
-    for k in 0..p.len() {
-        let (a, b) = (p[k], p[(k + 1) % p.len()]);
-        let (sa, sb) = (side(a), side(b));
-        if sa >= 0.0 {
-            out.push(a);
-        }
-        if (sa >= 0.0) != (sb >= 0.0) {
-            let t = sa / (sa - sb);
-            let mut x = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
-            // On the line exactly, so both halves meet without a gap or an overlap.
+    // A crossing is put on the line exactly, so both halves meet without a gap or an overlap.
+    clip_side(
+        p,
+        side,
+        |mut x| {
             x[axis] = at;
-            out.push(x);
+            x
+        },
+        &mut out,
+    );
+    out
+}
+
+/// One step of Sutherland–Hodgman: appends to `out` the part of polygon `input` where `side` is
+/// not negative, each crossing of the boundary passed through `on_boundary`.
+fn clip_side(input: &[Point2], side: impl Fn(Point2) -> f64, on_boundary: impl Fn(Point2) -> Point2, out: &mut Vec<Point2>) {
+    for k in 0..input.len() {
+        let (p, q) = (input[k], input[(k + 1) % input.len()]);
+        let (sp, sq) = (side(p), side(q));
+        if sp >= 0.0 {
+            out.push(p);
+        }
+        if (sp >= 0.0) != (sq >= 0.0) {
+            let t = sp / (sp - sq);
+            out.push(on_boundary([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]));
         }
     }
-    out
 }
 
 /// The slab sweep of [`union_area`] (see the module docs), quadratic in the polygons a slab holds.
@@ -253,6 +255,16 @@ mod tests {
             .collect()
     }
 
+    /// Seeded uniform numbers in [0, 1) (xorshift64).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// Closed forms: disjoint, overlapping, nested and crossing squares, and a clipped triangle.
     #[test]
     fn union_areas_match_closed_forms() {
@@ -280,13 +292,7 @@ mod tests {
     /// about the boundary's length times a cell, bounds the difference).
     #[test]
     fn union_area_matches_a_grid_count_of_many_polygons() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rand = uniform(0x2545_f491_4f6c_dd1d);
         let polys: Vec<Vec<Point2>> =
             (0..40).map(|_| rotated([rand() * 4.0, rand() * 4.0], 0.2 + 0.5 * rand(), 3 + (rand() * 5.0) as usize, rand() * 6.3)).collect();
         let area = union_area(&polys);
@@ -324,13 +330,7 @@ mod tests {
     /// lattice overlap their neighbours by a known amount.
     #[test]
     fn split_union_area_matches_one_sweep_and_a_lattice() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rand = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rand = uniform(0x9e37_79b9_7f4a_7c15);
         for (n, spread) in [(300, 10.0), (400, 3.0), (200, 0.5)] {
             let polys: Vec<Vec<Point2>> = (0..n)
                 .map(|_| rotated([rand() * spread, rand() * spread], 0.05 + 0.4 * rand(), 3 + (rand() * 5.0) as usize, rand() * 6.3))
