@@ -26,6 +26,19 @@ use crate::visibility::RayCaster;
 
 pub use crate::light::DistantSource;
 
+/// Where the sun is, as the scene file gave it or as computed.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SunReport {
+    /// Unit direction the light travels.
+    pub toward: [f64; 3],
+    /// Zenith angle (degrees).
+    pub zenith_deg: f64,
+    /// Azimuth (degrees clockwise from north), when computed from place and time.
+    pub azimuth_deg: Option<f64>,
+    /// Whether it is above the horizon (below, it gives no light).
+    pub above_horizon: bool,
+}
+
 /// Which way is up and which is north in the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Site {
@@ -245,7 +258,7 @@ impl<'a> DistantLight<'a> {
     /// `caster` `None`: no occlusion.
     #[must_use]
     pub fn new(sources: &'a [DistantSource], caster: Option<&'a RayCaster>, scene_diagonal: f64) -> DistantLight<'a> {
-        DistantLight { sources, caster, offset: crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * scene_diagonal }
+        DistantLight { sources, caster, offset: crate::visibility::SHADOW_ORIGIN_OFFSET_REL * scene_diagonal }
     }
 
     /// Whether a ray from `x` (normal `n`, on polygon `skip`) against the light of source `k`
@@ -338,7 +351,7 @@ pub fn two_sided_where_backs_see_light(scene: &mut crate::scene::Scene) -> usize
     }
     let caster = RayCaster::new(scene);
     let cells = escape_cells();
-    let offset = crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * scene.bounds().diagonal();
+    let offset = crate::visibility::SHADOW_ORIGIN_OFFSET_REL * scene.bounds().diagonal();
     let lit: Vec<bool> = candidates
         .par_iter()
         .map(|&i| {
@@ -411,7 +424,7 @@ pub fn power_leaving(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], ca
     use rayon::prelude::*;
     let cells = escape_cells();
     let diag = h.diagonal();
-    let offset = crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * diag;
+    let offset = crate::visibility::SHADOW_ORIGIN_OFFSET_REL * diag;
     let far = FAR_REL * diag;
     let any_open_back = open_back.iter().any(|&o| o);
     let leaves: Vec<u32> = h.leaves().filter(|&l| h.get(l).polygon().is_some()).collect();
@@ -426,7 +439,7 @@ pub fn power_leaving(h: &crate::hierarchy::Hierarchy, radiosity: &[[f64; 3]], ca
             }
             let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return ([0.0; 3], [0.0; 3], Vec::new()) };
             let points: Vec<DVec3> =
-                crate::geom::quadrature::weighted_points(poly, crate::luminaire::element_rule(poly)).map(|(x, _)| x).collect();
+                crate::geom::quadrature::weighted_points(poly, crate::geom::quadrature::element_rule(poly)).map(|(x, _)| x).collect();
             let frame = Site::new(e.normal, any_perpendicular(e.normal)).unwrap_or_default();
             let (mut out, mut backs) = (0.0, Vec::new());
             for (k, (d, w)) in cells.iter().enumerate() {
@@ -492,7 +505,7 @@ pub fn power_incident_on_backs(
         .map(|&leaf| {
             let e = h.get(leaf);
             let (Some(poly), Some(polygon)) = (e.poly(), e.polygon()) else { return (0, [0.0; 3]) };
-            (polygon, crate::luminaire::element_mean3(poly, |x| light.at(x, -e.normal, polygon)).map(|v| v * e.area))
+            (polygon, crate::geom::quadrature::element_mean3(poly, |x| light.at(x, -e.normal, polygon)).map(|v| v * e.area))
         })
         .collect();
     let (mut total, mut by) = ([0.0; 3], Vec::new());

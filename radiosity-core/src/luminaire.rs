@@ -29,12 +29,14 @@
 //! every polygon's mean direct light is within a share of the target of its own value
 //! ([`direct_splits`], [`deepen_direct`]).
 
-use crate::geom::{Aabb, DVec3, PolyKind, quadrature};
+use crate::geom::{Aabb, DVec3, quadrature};
 use crate::hierarchy::{ElementKind, Hierarchy, NONE};
 use crate::light::Lights;
 use crate::visibility::RayCaster;
 
+use crate::geom::quadrature::element_rule;
 pub use crate::light::luminaire::{Luminaire, LuminaireError};
+pub use crate::visibility::SHADOW_ORIGIN_OFFSET_REL;
 
 /// Subdivide (before refinement) a surface element lit by a luminaire while its bounding radius
 /// exceeds this fraction of its distance to the luminaire: the quadrature of `I cos θ / d²` over
@@ -45,21 +47,11 @@ pub const MAX_ANGULAR_DEPTH: u16 = 7;
 /// Most subdivision levels below an input polygon for a shadow boundary of a luminaire crossing an
 /// element (its quadrature points disagree on visibility).
 pub const MAX_SHADOW_DEPTH: u16 = 6;
-/// Shadow rays start this far (relative to the scene's diagonal) off the receiver, along its normal.
-pub const SHADOW_ORIGIN_OFFSET_REL: f64 = 1e-5;
 
 /// How far inside its corners (a share of the way to its centre) an element's visibility is
 /// tested, besides at its rule's points, to find shadow boundaries crossing it
 /// ([`update_direct`]).
 pub const CORNER_INSET: f64 = 1e-3;
-
-/// The quadrature rule of a surface element: 9 points on quads, 6 on triangles.
-pub(crate) fn element_rule(poly: &crate::geom::Poly) -> &'static quadrature::Rule {
-    match poly.kind {
-        PolyKind::Quad => &quadrature::QUAD_9,
-        PolyKind::Triangle => &quadrature::TRI_6,
-    }
-}
 
 /// Sees the luminaires from surface points: illuminance with one shadow ray per luminaire.
 pub struct DirectLight<'a> {
@@ -738,19 +730,6 @@ pub fn polygon_direct_means(h: &Hierarchy) -> Vec<[f64; 3]> {
         }
     }
     sums.into_iter().map(|(d, a)| if a > 0.0 { d.map(|v| v / a) } else { [0.0; 3] }).collect()
-}
-
-/// The mean of `f` per channel over a surface element by its [`element_rule`].
-pub(crate) fn element_mean3(poly: &crate::geom::Poly, mut f: impl FnMut(DVec3) -> [f64; 3]) -> [f64; 3] {
-    let (mut sum, mut wsum) = ([0.0; 3], 0.0);
-    for (x, w) in quadrature::weighted_points(poly, element_rule(poly)) {
-        let v = f(x);
-        for c in 0..3 {
-            sum[c] += w * v[c];
-        }
-        wsum += w;
-    }
-    if wsum > 0.0 { sum.map(|s| s / wsum) } else { [0.0; 3] }
 }
 
 /// The luminous flux (lm) of all luminaires of `h` arriving on its surfaces (front sides), from the

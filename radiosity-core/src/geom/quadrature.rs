@@ -79,6 +79,27 @@ pub fn weighted_points<'a>(poly: &'a crate::geom::Poly, rule: &'a Rule) -> impl 
     })
 }
 
+/// The quadrature rule of a surface element: 9 points on quads, 6 on triangles.
+pub(crate) fn element_rule(poly: &crate::geom::Poly) -> &'static Rule {
+    match poly.kind {
+        crate::geom::PolyKind::Quad => &QUAD_9,
+        crate::geom::PolyKind::Triangle => &TRI_6,
+    }
+}
+
+/// The mean of `f` per channel over a surface element by its [`element_rule`].
+pub(crate) fn element_mean3(poly: &crate::geom::Poly, mut f: impl FnMut(glam::DVec3) -> [f64; 3]) -> [f64; 3] {
+    let (mut sum, mut wsum) = ([0.0; 3], 0.0);
+    for (x, w) in weighted_points(poly, element_rule(poly)) {
+        let v = f(x);
+        for c in 0..3 {
+            sum[c] += w * v[c];
+        }
+        wsum += w;
+    }
+    if wsum > 0.0 { sum.map(|s| s / wsum) } else { [0.0; 3] }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

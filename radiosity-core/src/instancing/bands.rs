@@ -83,18 +83,7 @@ pub struct MaterialBands {
     pub emission: Vec<f64>,
 }
 
-/// Where the sun is, as the scene file gave it or as computed.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct SunReport {
-    /// Unit direction the light travels.
-    pub toward: [f64; 3],
-    /// Zenith angle (degrees).
-    pub zenith_deg: f64,
-    /// Azimuth (degrees clockwise from north), when computed from place and time.
-    pub azimuth_deg: Option<f64>,
-    /// Whether it is above the horizon (below, it gives no light).
-    pub above_horizon: bool,
-}
+pub use crate::daylight::SunReport;
 
 /// The scene's bands and daylight, per band.
 #[derive(Clone, Debug, Default)]

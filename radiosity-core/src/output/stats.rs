@@ -112,7 +112,7 @@ pub struct Stats {
     pub power_by_band: Option<std::collections::BTreeMap<String, BandPower>>,
     /// Where the sun is (scenes with a `[sun]`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sun: Option<crate::instancing::bands::SunReport>,
+    pub sun: Option<crate::daylight::SunReport>,
     /// Sampled fraction of the light leaving the surfaces that escapes the scene (null when not
     /// measured; see [`crate::visibility::escape_fraction`]).
     pub escape_fraction: Option<f64>,

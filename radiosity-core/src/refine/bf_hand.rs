@@ -2,9 +2,9 @@
 //! function: the baseline generated oracles are compared against. Every threshold is relative to
 //! the receiver's own irradiance ([`LinkCtx::threshold`]).
 
+use super::{CLUSTER_ERROR_COEF, SOURCE_VARIATION_WEIGHT};
 use super::{Decision, LinkCtx, Oracle};
 use crate::formfactor::FormFactorQuality;
-use crate::oracle::tools::{CLUSTER_ERROR_COEF, SOURCE_VARIATION_WEIGHT};
 
 /// Parameters of the BF oracle.
 #[derive(Clone, Copy, Debug)]

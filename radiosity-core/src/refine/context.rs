@@ -134,6 +134,15 @@ pub struct LinkAxis {
     pub projected_receiver: f64,
 }
 
+/// Weight of the source-variation error: the covariance of two quantities varying over the source
+/// (the kernel and the radiosity) is at most a quarter of the product of their ranges.
+pub const SOURCE_VARIATION_WEIGHT: f64 = 0.25;
+
+/// Relative error of the point-source cluster approximation at separation `d` of elements of
+/// bounding radii `r_S`, `r_R`: `CLUSTER_ERROR_COEF · ((r_S + r_R) / d)²` (the second-order term
+/// of `1/r²` averaged over the two elements; the first order cancels about the area centroids).
+pub const CLUSTER_ERROR_COEF: f64 = 1.0;
+
 /// Mean fraction of a cluster's area seen from a random direction (isotropic clusters: a quarter,
 /// as for the surface of a convex body).
 pub const CLUSTER_PROJECTED_FRACTION: f64 = 0.25;

@@ -11,8 +11,8 @@ mod driver;
 pub use bf_classic::{ClassicBf, first_guess_max};
 pub use bf_hand::{BfHand, BfParams, bf_decide, emitter_first};
 pub use context::{
-    CROSSING_SPLIT_DEPTH, Criterion, FRESH_VISIBILITY_SALT, KEPT_VISIBILITY_FACTOR, LinkCtx, LinkData, MAX_SOURCE_KERNEL_VARIATION,
-    Services, ShaftServices, UNSEEN_FRACTION, source_kernel_spread,
+    CLUSTER_ERROR_COEF, CROSSING_SPLIT_DEPTH, Criterion, FRESH_VISIBILITY_SALT, KEPT_VISIBILITY_FACTOR, LinkCtx, LinkData,
+    MAX_SOURCE_KERNEL_VARIATION, SOURCE_VARIATION_WEIGHT, Services, ShaftServices, UNSEEN_FRACTION, source_kernel_spread,
 };
 pub use data::{CHILD_VARIATION_FRACTION, ElementData, IRRADIANCE_FLOOR_REL, amplification};
 pub use driver::{BYTES_PER_ELEMENT, BYTES_PER_LINK, Link, RefineLimits, RefineStats, push_direct_shadows, refine};

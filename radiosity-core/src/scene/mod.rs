@@ -158,9 +158,9 @@ pub struct Scene {
     /// What was repaired or skipped.
     pub warnings: SceneWarnings,
     /// Photometric luminaires (see [`crate::luminaire`]); only in photometric scenes.
-    pub luminaires: Vec<crate::luminaire::Luminaire>,
+    pub luminaires: Vec<crate::light::Luminaire>,
     /// Distant sources: the sun and the sky's cells (see [`crate::daylight`]).
-    pub distant: Vec<crate::daylight::DistantSource>,
+    pub distant: Vec<crate::light::DistantSource>,
     /// Radiometric (W, W/m²) or photometric (lm, lx: every channel a luminous quantity).
     pub units: crate::photometry::Units,
 }

@@ -9,6 +9,10 @@ mod rays;
 pub mod shaft;
 
 pub(crate) use rays::BvhFrame;
+
+/// Shadow rays start this far (relative to the scene's diagonal) off the receiver, along its normal.
+pub const SHADOW_ORIGIN_OFFSET_REL: f64 = 1e-5;
+
 pub use rays::{
     ESCAPE_SAMPLES, KERNEL_REGULARISATION, MIN_DIRECTION_COMPONENT, RayCaster, Rng, SEGMENT_END_EPS, VisibilityConfig, back_of,
     escape_fraction, sampled_visibility,

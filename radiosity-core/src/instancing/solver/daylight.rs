@@ -182,7 +182,7 @@ pub(super) fn polygon_irradiance(
 /// run past the scene's box.
 fn ray_span(diag: f64) -> (f64, f64) {
     let diag = diag.max(f64::MIN_POSITIVE);
-    let offset = crate::luminaire::SHADOW_ORIGIN_OFFSET_REL * diag;
+    let offset = crate::visibility::SHADOW_ORIGIN_OFFSET_REL * diag;
     (offset, 1.01 * diag + offset)
 }
 

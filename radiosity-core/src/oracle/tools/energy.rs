@@ -35,9 +35,7 @@ crate::answer_enum! {
     }
 }
 
-/// Weight of the source-variation error: the covariance of two quantities varying over the source
-/// (the kernel and the radiosity) is at most a quarter of the product of their ranges.
-pub const SOURCE_VARIATION_WEIGHT: f64 = 0.25;
+pub use crate::refine::{CLUSTER_ERROR_COEF, SOURCE_VARIATION_WEIGHT};
 
 /// Is the error of the receiver's mean irradiance, for the source's radiosity varying within its
 /// leaves where the kernel does, above the threshold? `w · ΔB_S · SOURCE_VARIATION_WEIGHT`, `ΔB_S` how much the source's radiosity
@@ -87,11 +85,6 @@ impl Tool for PartialVisibility {
         if 2.0 * v * (1.0 - v) * transfer > threshold { ErrorBound::Above } else { ErrorBound::Below }
     }
 }
-
-/// Relative error of the point-source cluster approximation at separation `d` of elements of
-/// bounding radii `r_S`, `r_R`: `CLUSTER_ERROR_COEF · ((r_S + r_R) / d)²` (the second-order term
-/// of `1/r²` averaged over the two elements; the first order cancels about the area centroids).
-pub const CLUSTER_ERROR_COEF: f64 = 1.0;
 
 /// Is the error of the cluster approximation above the threshold? For a link with a cluster at
 /// either end, `B_S · F · CLUSTER_ERROR_COEF · ((r_S + r_R) / d)²`; `Below` between surfaces.
