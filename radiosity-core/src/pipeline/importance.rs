@@ -11,9 +11,14 @@
 //! error falls from 2.6% to within 1%, at a fraction of the cost of a finer target everywhere (see
 //! `tests/accuracy.rs`).
 
+use super::refining::{direct_tolerance, refine_direct};
+use super::{Config, Context, LevelReport, State};
 use crate::hierarchy::ElementId;
 use crate::points::{CalcPoint, LeafError, PointGather, PointIrradiance, PointsConfig, SolveParts};
+use crate::refine;
+use crate::solve::Solution;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Most rounds of importance subdivision after the levels.
 pub const IMPORTANCE_MAX_ROUNDS: usize = 8;
@@ -70,6 +75,139 @@ pub struct ImportanceReport {
     pub capped: bool,
     /// The rounds stopped for the worst point's estimate not falling ([`IMPORTANCE_MIN_FALL`]).
     pub stalled: bool,
+}
+
+/// What the importance rounds carry from one to the next.
+pub(super) struct Rounds {
+    /// Rounds that split leaves or tightened links so far (each a level of its own).
+    pub(super) rounds: usize,
+    /// The memory the rounds may hold ([`IMPORTANCE_MAX_GROWTH`] times what the levels ended
+    /// with), set by the first round.
+    cap: usize,
+    /// Subdivisions the rounds' refinement refused for memory.
+    refused: u64,
+    /// The worst point estimate of the round before.
+    previous_worst: f64,
+    /// The memory of the round before.
+    previous_bytes: usize,
+    /// What the rounds did, once one ran.
+    pub(super) report: Option<ImportanceReport>,
+    /// The point sets' results as the last round read them.
+    pub(super) results: Vec<Vec<PointIrradiance>>,
+}
+
+impl Rounds {
+    /// No round yet.
+    pub(super) fn new() -> Rounds {
+        Rounds {
+            rounds: 0,
+            cap: usize::MAX,
+            refused: 0,
+            previous_worst: f64::INFINITY,
+            previous_bytes: 1,
+            report: None,
+            results: Vec::new(),
+        }
+    }
+
+    /// What refinement may take: the memory budget, and during the rounds their own cap as well.
+    pub(super) fn limits(&self, config: &Config) -> refine::RefineLimits {
+        refine::RefineLimits { max_bytes: if self.rounds > 0 { config.max_memory_bytes.min(self.cap) } else { config.max_memory_bytes } }
+    }
+
+    /// Where refinement counts the subdivisions it refused for memory during the rounds (`None`
+    /// before them: the run's own counters).
+    pub(super) fn refused_in_rounds(&mut self) -> Option<&mut u64> {
+        (self.rounds > 0).then_some(&mut self.refused)
+    }
+
+    /// One importance round after a level (of threshold scale `scale`, its report `last_report`)
+    /// whose polygon means met `target` with estimate `estimate`: reads the point sets from
+    /// `solution` ([`round`]), and unless every set is within the target, the rounds are capped
+    /// or stalled, or the most rounds ran, subdivides the leaves and tightens the links the points'
+    /// errors come from, and refines the direct light. Returns whether another level runs for
+    /// the next round.
+    #[expect(clippy::too_many_arguments, reason = "the pipeline's state this step reads and writes, passed explicitly")]
+    pub(super) fn run(
+        &mut self,
+        cx: &Context<'_>,
+        state: &mut State,
+        solution: &Solution,
+        last_report: Option<&mut LevelReport>,
+        estimate: f64,
+        target: f64,
+        scale: f64,
+    ) -> bool {
+        let (config, services) = (cx.config, cx.services);
+        let t = Instant::now();
+        let parts = SolveParts {
+            hierarchy: &state.h,
+            links: &state.links,
+            solution,
+            lights: &services.lights,
+            caster: &services.caster,
+            convex_enclosure: services.traits.as_ref().is_some_and(|t| !t.needs_visibility),
+            error_estimate: Some(estimate),
+            polygon_errors: Some(&state.polygon_errors),
+            variation: (config.measure_variation && state.data.variation.len() == state.h.len()).then_some(state.data.variation.as_slice()),
+        };
+        let round = round(&parts, cx.point_sets, target, &cx.points_config, (self.rounds > 0).then_some(self.results.as_slice()));
+        if let Some(l) = last_report {
+            l.points_error = Some(round.worst);
+        }
+        let report = self.report.get_or_insert(ImportanceReport { worst_before: round.worst, ..ImportanceReport::default() });
+        (report.worst_after, report.met) = (round.worst, round.worst <= target);
+        self.results = round.results;
+        let bytes = state.h.len() * refine::BYTES_PER_ELEMENT + state.links.len() * refine::BYTES_PER_LINK;
+        if self.rounds == 0 {
+            self.cap = (bytes as f64 * IMPORTANCE_MAX_GROWTH) as usize;
+        }
+        // Out of reach: at the last round's fall and growth, the rounds still needed would
+        // take more than IMPORTANCE_OUT_OF_REACH times the cap.
+        let out_of_reach = self.rounds > 0 && round.worst < self.previous_worst && round.worst > target && {
+            let needed = (round.worst / target).ln() / (self.previous_worst / round.worst).ln();
+            let growth = (bytes as f64 / self.previous_bytes as f64).max(1.0);
+            bytes as f64 * growth.powf(needed) > IMPORTANCE_OUT_OF_REACH * self.cap as f64
+        };
+        report.capped = self.refused > 0 || bytes > self.cap.min(config.max_memory_bytes) || out_of_reach;
+        report.stalled = round.worst > IMPORTANCE_MIN_FALL * self.previous_worst;
+        (self.previous_worst, self.previous_bytes) = (round.worst, bytes);
+        let go_on = !report.met && !report.capped && !report.stalled && self.rounds < cx.max_rounds;
+        let mut made = 0;
+        if go_on {
+            for &leaf in &round.split {
+                if state.h.get(leaf).n_children == 0 && state.h.subdivide(leaf) {
+                    state.data.inherit(&state.h, leaf);
+                    made += 1;
+                }
+            }
+            for &leaf in &round.tighten {
+                state.data.tighten(&state.h, leaf, IMPORTANCE_TIGHTEN);
+            }
+            for e in state.h.match_sides() {
+                state.data.inherit(&state.h, e);
+            }
+            let direct_limit = config.max_memory_bytes.min(self.cap).saturating_sub(state.links.len() * refine::BYTES_PER_LINK);
+            refine_direct(
+                &mut state.h,
+                &mut state.data,
+                &mut state.quadrature,
+                &services.lights,
+                services.direct_caster(),
+                direct_tolerance(cx.target_error, scale),
+                &state.polygon_factor,
+                direct_limit,
+            );
+        }
+        state.timings.importance += t.elapsed().as_secs_f64();
+        if !go_on || (made == 0 && round.tighten.is_empty()) {
+            return false;
+        }
+        report.rounds += 1;
+        report.leaves_split += made;
+        self.rounds += 1;
+        true
+    }
 }
 
 /// One importance round's reading of the point sets.
