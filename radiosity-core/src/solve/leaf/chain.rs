@@ -1,0 +1,180 @@
+//! The links along an unknown's chain: the unknowns of a cut below each element ([`LeavesBelow`]),
+//! the links received at each element ([`LinksByReceiver`]), and the chain of links of one unknown
+//! with its coefficients, stored or recomputed ([`Chain`]).
+
+use super::precision::Precision;
+use super::weights::shape_form_factor;
+use crate::formfactor::{self, FormFactorQuality};
+use crate::hierarchy::{ElementId, Hierarchy, NONE};
+use crate::refine::Link;
+use crate::solve::cut::Cut;
+use rayon::prelude::*;
+
+/// The unknowns of a cut below each element, as ranges of one depth-first list (an element at or
+/// below the cut has none: its value is its cut ancestor's).
+pub(super) struct LeavesBelow {
+    leaves: Vec<ElementId>,
+    range: Vec<(u32, u32)>,
+}
+
+impl LeavesBelow {
+    pub(super) fn new(cut: &Cut<'_>) -> LeavesBelow {
+        let h = cut.hierarchy();
+        let mut leaves = Vec::new();
+        let mut range = vec![(0u32, 0u32); h.len()];
+        // Iterative post-order: an element's range closes after its children's.
+        let mut stack = vec![(h.root, false)];
+        while let Some((e, done)) = stack.pop() {
+            if done {
+                let kids = h.children_of(e);
+                if !kids.is_empty() {
+                    range[e as usize] = (range[kids[0] as usize].0, range[kids[kids.len() - 1] as usize].1);
+                }
+                continue;
+            }
+            if cut.unknown_of(e).is_some() {
+                range[e as usize] = (leaves.len() as u32, leaves.len() as u32 + 1);
+                leaves.push(e);
+                continue;
+            }
+            stack.push((e, true));
+            for &k in h.children_of(e).iter().rev() {
+                stack.push((k, false));
+            }
+        }
+        LeavesBelow { leaves, range }
+    }
+
+    pub(super) fn below(&self, e: ElementId) -> &[ElementId] {
+        let (a, b) = self.range[e as usize];
+        &self.leaves[a as usize..b as usize]
+    }
+}
+
+/// The chain of links of one unknown: every link received at the unknown or an ancestor, in the
+/// order coefficients are stored in.
+#[derive(Clone, Copy)]
+pub(super) struct Chain<'c> {
+    pub(super) h: &'c Hierarchy,
+    pub(super) links: &'c [Link],
+    pub(super) sorted: &'c [u32],
+    pub(super) range: &'c [(u32, u32)],
+    pub(super) precision: Precision,
+}
+
+impl Chain<'_> {
+    /// Number of links on the chain of `leaf`.
+    pub(super) fn len(&self, leaf: ElementId) -> usize {
+        let mut n = 0;
+        let mut a = leaf;
+        while a != NONE {
+            let (lo, hi) = self.range[a as usize];
+            n += (hi - lo) as usize;
+            a = self.h.get(a).parent;
+        }
+        n
+    }
+
+    /// Calls `f(link)` for every link on the chain of `leaf`, in storage order.
+    pub(super) fn for_each_link(&self, leaf: ElementId, mut f: impl FnMut(u32)) {
+        let mut a = leaf;
+        while a != NONE {
+            let (lo, hi) = self.range[a as usize];
+            for &k in &self.sorted[lo as usize..hi as usize] {
+                f(k);
+            }
+            a = self.h.get(a).parent;
+        }
+    }
+
+    /// Calls `f(link, F(leaf ← source) V)` for every link on the chain of `leaf`, in storage order:
+    /// a link at the leaf with its stored form factor, one at an ancestor with the leaf's own
+    /// ([`shape_form_factor`]); negative values (quadrature noise) as 0, every value rounded to
+    /// `f32` (and then to the chain's [`Precision`] by [`Chain::for_each`]).
+    fn for_each_raw(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
+        let mut a = leaf;
+        while a != NONE {
+            let (lo, hi) = self.range[a as usize];
+            for &k in &self.sorted[lo as usize..hi as usize] {
+                let l = &self.links[k as usize];
+                let ff = if a == leaf { l.ff } else { shape_form_factor(self.h, l.source, leaf) };
+                let c = ff * l.vis;
+                f(k, if c > 0.0 { c as f32 } else { 0.0 });
+            }
+            a = self.h.get(a).parent;
+        }
+    }
+
+    /// [`Chain::for_each_raw`] with every value as it is applied in the chain's [`Precision`]: what
+    /// a stored coefficient decodes to.
+    pub(super) fn for_each(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
+        let p = self.precision;
+        self.for_each_raw(leaf, |k, c| f(k, p.round(c)));
+    }
+
+    /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets
+    /// relative to `coef`, length `unknowns.len() + 1`), each as `store` turns it, in parallel.
+    pub(super) fn fill<T: Send>(&self, unknowns: &[ElementId], start: &[usize], coef: &mut [T], store: impl Fn(f32) -> T + Sync) {
+        let mut slices: Vec<&mut [T]> = Vec::with_capacity(unknowns.len());
+        let mut rest = coef;
+        for w in start.windows(2) {
+            let (a, b) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+            slices.push(a);
+            rest = b;
+        }
+        slices.into_par_iter().zip(unknowns.par_iter()).with_min_len(16).for_each(|(out, &u)| {
+            let mut j = 0;
+            self.for_each_raw(u, |_, c| {
+                out[j] = store(c);
+                j += 1;
+            });
+        });
+    }
+}
+
+/// Links grouped by receiver (sorted by receiver, then source).
+pub(in crate::solve) struct LinksByReceiver<'l> {
+    links: &'l [Link],
+    pub(super) sorted: Vec<u32>,
+    pub(super) range: Vec<(u32, u32)>,
+}
+
+impl<'l> LinksByReceiver<'l> {
+    pub(in crate::solve) fn new(h: &Hierarchy, links: &'l [Link]) -> LinksByReceiver<'l> {
+        let mut sorted: Vec<u32> = (0..links.len() as u32).collect();
+        sorted.sort_by_key(|&k| (links[k as usize].receiver, links[k as usize].source));
+        let mut range = vec![(0u32, 0u32); h.len()];
+        for (k, &i) in sorted.iter().enumerate() {
+            let r = &mut range[links[i as usize].receiver as usize];
+            if r.1 == 0 {
+                r.0 = k as u32;
+            }
+            r.1 = k as u32 + 1;
+        }
+        LinksByReceiver { links, sorted, range }
+    }
+
+    /// The indices (into the links) of the links received by element `e`.
+    pub(in crate::solve) fn indices_at(&self, e: ElementId) -> &[u32] {
+        let (lo, hi) = self.range[e as usize];
+        &self.sorted[lo as usize..hi as usize]
+    }
+
+    /// The links received by element `e`.
+    pub(in crate::solve) fn at(&self, e: ElementId) -> impl Iterator<Item = &'l Link> + '_ {
+        self.indices_at(e).iter().map(|&k| &self.links[k as usize])
+    }
+
+    /// Calls `f(source, F·V)` for every link on the chain from `leaf` to the root, with the form
+    /// factor evaluated for `leaf` itself (a link at the leaf keeps its stored one).
+    pub(in crate::solve) fn leaf_chain(&self, h: &Hierarchy, leaf: ElementId, mut f: impl FnMut(ElementId, f64)) {
+        let mut a = leaf;
+        while a != NONE {
+            for l in self.at(a) {
+                let ff = if a == leaf { l.ff } else { formfactor::link_form_factor(h, l.source, leaf, FormFactorQuality::Precise) };
+                f(l.source, ff * l.vis);
+            }
+            a = h.get(a).parent;
+        }
+    }
+}

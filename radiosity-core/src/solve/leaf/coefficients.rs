@@ -1,0 +1,400 @@
+//! Building the leaf operator's coefficients ([`LeafCoefficients`]) for a cut: the receiver side
+//! along each unknown's chain (stored within the budget), the links received inside an unknown,
+//! each link's transfer, the source side's weights, the closure of a closed scene, and the value
+//! each link sends. The contract they keep is in the folder's `mod.rs`.
+
+use super::chain::{Chain, LeavesBelow, LinksByReceiver};
+use super::precision::{Precision, Stored, encode};
+use super::weights::{SourceWeights, own_weights, source_weights};
+use super::{CLOSURE_MAX, CLOSURE_MIN, CLOSURE_NOISE_MAX, LeafCoefficients, STREAM_BATCH_ENTRIES, SourceValue, WEIGHT_CHUNK};
+use crate::hierarchy::{ElementId, Hierarchy, NONE};
+use crate::refine::Link;
+use crate::solve::cut::Cut;
+use rayon::prelude::*;
+
+impl LeafCoefficients {
+    /// Evaluates `link_form_factor(source, leaf)` for every leaf and every link on its chain, and
+    /// the source weights, each link's two sides scaled to the same transfer (see the module docs).
+    #[must_use]
+    pub fn new(h: &Hierarchy, links: &[Link]) -> LeafCoefficients {
+        LeafCoefficients::for_cut(&Cut::leaves(h), links, false, usize::MAX, Precision::Single)
+    }
+
+    /// [`LeafCoefficients::new`] with the unknowns of `cut` in place of the leaves: a link received
+    /// below an unknown adds its transfer to the unknown's mean (area-weighted), a link sent from
+    /// below one sends the unknown's radiosity. In a `closed` scene every unknown's light is
+    /// delivered whole ([`LeafCoefficients::closure`]). Chain coefficients are stored in
+    /// `precision` for the unknowns, in cut order, whose coefficients fit in `max_bytes` with
+    /// those before them; the others' are recomputed at every application (see
+    /// [`LeafCoefficients::stored_unknowns`]).
+    #[must_use]
+    pub fn for_cut(cut: &Cut<'_>, links: &[Link], closed: bool, max_bytes: usize, precision: Precision) -> LeafCoefficients {
+        let h = cut.hierarchy();
+        let LinksByReceiver { sorted, range, .. } = LinksByReceiver::new(h, links);
+        let chain = Chain { h, links, sorted: &sorted, range: &range, precision };
+        let max_stored = max_bytes / precision.bytes();
+        let unknowns = cut.elements();
+        // Receiver side, along each unknown's chain: stored while within the budget.
+        let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
+        let chain_entries: usize = lens.iter().sum();
+        let mut start = Vec::with_capacity(unknowns.len() + 1);
+        start.push(0);
+        for &len in &lens {
+            let next = start[start.len() - 1] + len;
+            if next > max_stored {
+                break;
+            }
+            start.push(next);
+        }
+        let stored = start.len() - 1;
+        let coef = match precision {
+            Precision::Single => {
+                let mut v = vec![0.0f32; start[stored]];
+                chain.fill(&unknowns[..stored], &start, &mut v, |c| c);
+                Stored::Single(v)
+            }
+            Precision::Half => {
+                let mut v = vec![0u16; start[stored]];
+                chain.fill(&unknowns[..stored], &start, &mut v, encode);
+                Stored::Half(v)
+            }
+        };
+        // Links received inside an unknown: their transfer, spread over its area.
+        let inside_lists: Vec<Vec<(u32, f64)>> = unknowns
+            .par_iter()
+            .map(|&u| {
+                let area = h.get(u).area;
+                let mut list = Vec::new();
+                let mut stack: Vec<ElementId> = h.children_of(u).to_vec();
+                while let Some(d) = stack.pop() {
+                    let (lo, hi) = range[d as usize];
+                    for &k in &sorted[lo as usize..hi as usize] {
+                        let l = &links[k as usize];
+                        let c = h.get(d).area / area * l.ff * l.vis;
+                        if c > 0.0 {
+                            list.push((k, c));
+                        }
+                    }
+                    stack.extend_from_slice(h.children_of(d));
+                }
+                list
+            })
+            .collect();
+        let mut inside_start = Vec::with_capacity(unknowns.len() + 1);
+        inside_start.push(0u32);
+        let mut inside = Vec::new();
+        for list in inside_lists {
+            inside.extend(list);
+            inside_start.push(inside.len() as u32);
+        }
+        // The receiver side's total per link, `Σ_unknowns A F V`, summed in cut order (unstored
+        // unknowns' coefficients computed a batch at a time).
+        let mut receiver_total = vec![0.0; links.len()];
+        // Adds unknown `i`'s `A F V` to its links' totals, its `j`th chain coefficient `coef(j)`.
+        let mut add_unknown = |i: usize, coef: &dyn Fn(usize) -> f32| {
+            let u = unknowns[i];
+            let area = h.get(u).area;
+            let mut j = 0;
+            chain.for_each_link(u, |k| {
+                receiver_total[k as usize] += area * f64::from(coef(j));
+                j += 1;
+            });
+            for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
+                receiver_total[k as usize] += area * c;
+            }
+        };
+        for (i, w) in start.windows(2).enumerate() {
+            add_unknown(i, &|j| coef.get(w[0] + j));
+        }
+        let mut first = stored;
+        let mut buffer = Vec::new();
+        while first < unknowns.len() {
+            let mut batch_start = vec![0];
+            let mut last = first;
+            while last < unknowns.len() && (last == first || batch_start[batch_start.len() - 1] + lens[last] <= STREAM_BATCH_ENTRIES) {
+                batch_start.push(batch_start[batch_start.len() - 1] + lens[last]);
+                last += 1;
+            }
+            buffer.clear();
+            buffer.resize(batch_start[batch_start.len() - 1], 0.0f32);
+            chain.fill(&unknowns[first..last], &batch_start, &mut buffer, |c| precision.round(c));
+            for i in first..last {
+                let b = &buffer[batch_start[i - first]..];
+                add_unknown(i, &|j| b[j]);
+            }
+            first = last;
+        }
+        drop(buffer);
+        // The transfer each link carries, from the side evaluated exactly: between surfaces the
+        // link's own `A_R F V` (its precise form factor); from a surface to a cluster the sum over
+        // the receiver's unknowns (each with its precise form factor from the surface); from a
+        // cluster to a surface the sum over the source's unknowns (likewise, by reciprocity, set
+        // with the source side below); between clusters the receiver's sum.
+        let mut transfer: Vec<f64> = links
+            .iter()
+            .enumerate()
+            .map(|(k, l)| {
+                if h.get(l.source).poly().is_some() && h.get(l.receiver).poly().is_some() {
+                    h.get(l.receiver).area * l.ff * l.vis
+                } else {
+                    receiver_total[k]
+                }
+            })
+            .collect();
+        // Source side: per link, `A_y F(y ← receiver) V` for every unknown `y` below a source
+        // above the cut, computed per source (its links together) and kept only as weights.
+        let below = LeavesBelow::new(cut);
+        let mut value = vec![SourceValue::Leaf(NONE); links.len()];
+        let mut by_source: Vec<u32> = Vec::new();
+        for (k, l) in links.iter().enumerate() {
+            match cut.unknown_of(l.source) {
+                Some(i) => value[k] = SourceValue::Leaf(unknowns[i]),
+                None => by_source.push(k as u32),
+            }
+        }
+        by_source.sort_by_key(|&k| (links[k as usize].source, k));
+        let groups: Vec<&[u32]> = by_source.chunk_by(|&a, &b| links[a as usize].source == links[b as usize].source).collect();
+        // The weights are made a chunk of sources at a time into vectors of their exact size:
+        // made all at once, then copied into vectors grown by doubling, they held up to three
+        // times their size (573 MB of a 1.01 GB heap peak on a 3,200-leaf canopy).
+        let (mut n_leaves, mut n_weights) = (0, 0);
+        for group in &groups {
+            let s = links[group[0] as usize].source;
+            let n = below.below(s).len();
+            let own = group.iter().filter(|&&k| own_weights(h, &below, &links[k as usize])).count();
+            n_leaves += n;
+            n_weights += n * (own + usize::from(own < group.len()));
+        }
+        let (mut weight_leaf, mut weight) = (Vec::with_capacity(n_leaves), Vec::with_capacity(n_weights));
+        let mut shared = Vec::new();
+        for chunk in groups.chunks(WEIGHT_CHUNK) {
+            let results: Vec<SourceWeights> = chunk.par_iter().map(|group| source_weights(h, links, &below, group, &transfer)).collect();
+            for (group, r) in chunk.iter().zip(results) {
+                let s = links[group[0] as usize].source;
+                for (k, t) in r.transfer {
+                    transfer[k as usize] = t;
+                }
+                if r.own.is_empty() && r.shared.is_none() {
+                    continue;
+                }
+                let leaves = weight_leaf.len();
+                weight_leaf.extend_from_slice(below.below(s));
+                for (k, w) in r.own {
+                    let begin = weight.len() as u32;
+                    weight.extend(w);
+                    value[k as usize] = SourceValue::Own(begin, weight.len() as u32, leaves as u32);
+                }
+                if let Some(w) = r.shared {
+                    let begin = weight.len();
+                    weight.extend(w);
+                    for &k in r.far.iter() {
+                        value[k as usize] = SourceValue::Shared(shared.len() as u32);
+                    }
+                    shared.push((s, begin, weight.len(), leaves));
+                }
+            }
+        }
+        let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
+        let mut c = LeafCoefficients {
+            sorted,
+            range,
+            start,
+            coef,
+            chain_entries,
+            inside_start,
+            inside,
+            scale,
+            value,
+            weight_leaf,
+            weight,
+            shared,
+            closure: (1.0, 1.0),
+            closure_change: Vec::new(),
+        };
+        if closed {
+            c.close(cut, &transfer);
+        }
+        c
+    }
+
+    /// The smallest and largest factor the closure applied to a source unknown's delivered light
+    /// (1 and 1 in an open scene): how far the links' visibility and form factors were from
+    /// delivering each unknown's light whole.
+    #[must_use]
+    pub fn closure(&self) -> (f64, f64) {
+        self.closure
+    }
+
+    /// Per link (in the order of the links given), the factor the closure applied to the light
+    /// it carries, less 1, where that is a correction of sampling (`CLOSURE_NOISE_MAX`, 2%; 0 where
+    /// it makes up for a cover); empty in an open scene. See [`super::closure_error`](crate::solve::closure_error).
+    #[must_use]
+    pub fn closure_changes(&self) -> &[f32] {
+        &self.closure_change
+    }
+
+    /// In a closed scene every bit of light leaving a surface lands on another, so the fractions of
+    /// each unknown's light that its links deliver sum to 1. Sampled visibility misses small
+    /// occluders (a 5 cm lamp in a 4 m room, every wall seeing the others through it and the lamp
+    /// too: 1e-4 of each wall's light counted twice, 0.26% of the power at ρ = 0.95) and quadrature
+    /// leaves ~1e-5: scale each unknown's shares in all its links so that they sum to 1, and each
+    /// link's receiver side with them. Energy is then conserved exactly.
+    fn close(&mut self, cut: &Cut<'_>, transfer: &[f64]) {
+        let h = cut.hierarchy();
+        let n = cut.len();
+        // Delivered fraction of every unknown: Σ_links τ q_y / A_y.
+        let mut delivered = vec![0.0; n];
+        let mut add = |y: ElementId, x: f64| {
+            if let Some(i) = cut.unknown_of(y) {
+                delivered[i] += x / h.get(cut.elements()[i]).area;
+            }
+        };
+        for (k, v) in self.value.iter().enumerate() {
+            let (lo, hi, leaves) = match *v {
+                SourceValue::Leaf(e) => {
+                    add(e, transfer[k]);
+                    continue;
+                }
+                SourceValue::Own(lo, hi, leaves) => (lo as usize, hi as usize, leaves as usize),
+                SourceValue::Shared(i) => {
+                    let (_, lo, hi, leaves) = self.shared[i as usize];
+                    (lo, hi, leaves)
+                }
+            };
+            for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
+                add(y, transfer[k] * q);
+            }
+        }
+        let factor: Vec<f64> = delivered.iter().map(|&d| if d > 0.0 { (1.0 / d).clamp(CLOSURE_MIN, CLOSURE_MAX) } else { 1.0 }).collect();
+        let f = |y: ElementId| cut.unknown_of(y).map_or(1.0, |i| factor[i]);
+        // Rescale the weights of each range by the factors, renormalise, and keep each range's
+        // mean factor: a link's transfer scales by its range's mean factor.
+        let mut rescale = |lo: usize, hi: usize, leaves: usize| -> f64 {
+            let mut sum = 0.0;
+            for (&y, w) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&mut self.weight[lo..hi]) {
+                *w *= f(y);
+                sum += *w;
+            }
+            if sum > 0.0 {
+                self.weight[lo..hi].iter_mut().for_each(|w| *w /= sum);
+            }
+            sum
+        };
+        let own_scale: Vec<Option<f64>> = self
+            .value
+            .iter()
+            .map(|v| match *v {
+                SourceValue::Own(lo, hi, leaves) => Some(rescale(lo as usize, hi as usize, leaves as usize)),
+                _ => None,
+            })
+            .collect();
+        let shared_scale: Vec<f64> = (0..self.shared.len())
+            .map(|i| {
+                let (_, lo, hi, leaves) = self.shared[i];
+                rescale(lo, hi, leaves)
+            })
+            .collect();
+        self.closure_change = Vec::with_capacity(self.scale.len());
+        for ((s, v), own) in self.scale.iter_mut().zip(&self.value).zip(&own_scale) {
+            let m = match *v {
+                SourceValue::Leaf(e) => f(e),
+                SourceValue::Own(..) => own.unwrap_or(1.0),
+                SourceValue::Shared(i) => shared_scale[i as usize],
+            };
+            *s *= m;
+            // Beyond sampling's reach the factor makes up for a cover, which is geometry.
+            let noise = if (m - 1.0).abs() <= CLOSURE_NOISE_MAX { m - 1.0 } else { 0.0 };
+            self.closure_change.push(noise as f32);
+        }
+        let (lo, hi) = factor.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+        self.closure = if factor.is_empty() { (1.0, 1.0) } else { (lo, hi) };
+    }
+
+    /// How the chain coefficients are stored.
+    #[must_use]
+    pub fn precision(&self) -> Precision {
+        self.coef.precision()
+    }
+
+    /// Stored coefficients and weights.
+    #[must_use]
+    pub fn entries(&self) -> usize {
+        self.coef.len() + self.inside.len() + self.weight.len()
+    }
+
+    /// Chain coefficients of every unknown, stored or recomputed at every application.
+    #[must_use]
+    pub fn chain_entries(&self) -> usize {
+        self.chain_entries
+    }
+
+    /// How many unknowns (the first ones, in cut order) have their chain coefficients stored; the
+    /// others' are recomputed at every application, giving the same values.
+    #[must_use]
+    pub fn stored_unknowns(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// The share of the chain coefficients computed again at every application (0 when all are
+    /// stored).
+    #[must_use]
+    pub fn recomputed_share(&self) -> f64 {
+        if self.chain_entries == 0 { 0.0 } else { 1.0 - self.coef.len() as f64 / self.chain_entries as f64 }
+    }
+
+    /// Whether every unknown's chain coefficients are stored.
+    #[must_use]
+    pub fn is_complete(&self) -> bool {
+        self.stored_unknowns() + 1 == self.inside_start.len()
+    }
+
+    /// Heap bytes held.
+    #[must_use]
+    pub fn bytes(&self) -> usize {
+        self.sorted.len() * size_of::<u32>()
+            + self.range.len() * size_of::<(u32, u32)>()
+            + self.start.len() * size_of::<usize>()
+            + self.coef.len() * self.coef.precision().bytes()
+            + self.inside_start.len() * size_of::<u32>()
+            + self.inside.len() * size_of::<(u32, f64)>()
+            + self.scale.len() * size_of::<f64>()
+            + self.value.len() * size_of::<SourceValue>()
+            + self.weight_leaf.len() * size_of::<ElementId>()
+            + self.weight.len() * size_of::<f64>()
+            + self.shared.len() * size_of::<(ElementId, usize, usize, usize)>()
+    }
+
+    /// The leaves and weights of the range `lo..hi` of `weight`, whose source's leaves start at
+    /// `leaves` in `weight_leaf`.
+    fn weighted_leaves(&self, lo: usize, hi: usize, leaves: usize) -> impl Iterator<Item = (&ElementId, &f64)> {
+        self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi])
+    }
+
+    /// The radiosity each link sends (see the module docs), for leaf radiosity read from `b` (per
+    /// element), times the link's receiver-side scale.
+    pub(super) fn link_values(&self, b: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let weighted = |lo: usize, hi: usize, leaves: usize| {
+            let mut acc = [0.0; 3];
+            for (&y, &w) in self.weighted_leaves(lo, hi, leaves) {
+                let by = b[y as usize];
+                for c in 0..3 {
+                    acc[c] += w * by[c];
+                }
+            }
+            acc
+        };
+        let shared: Vec<[f64; 3]> = self.shared.par_iter().map(|&(_, lo, hi, leaves)| weighted(lo, hi, leaves)).collect();
+        self.value
+            .par_iter()
+            .zip(&self.scale)
+            .map(|(v, &s)| {
+                let x = match *v {
+                    SourceValue::Leaf(e) => b[e as usize],
+                    SourceValue::Own(lo, hi, leaves) => weighted(lo as usize, hi as usize, leaves as usize),
+                    SourceValue::Shared(i) => shared[i as usize],
+                };
+                x.map(|x| x * s)
+            })
+            .collect()
+    }
+}
