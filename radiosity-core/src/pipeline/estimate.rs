@@ -33,7 +33,7 @@ impl State {
         let (config, target_error, services) = (cx.config, cx.target_error, cx.services);
         let (h, links, sol) = (&self.h, &self.links, &leaf.solution);
         let t = Instant::now();
-        let means: Vec<[f64; 3]> = crate::output::polygon_results(h, sol).into_iter().map(|r| r.b).collect();
+        let means: Vec<[f64; 3]> = crate::solve::polygon_results(h, sol).into_iter().map(|r| r.b).collect();
         let top = solve::largest_non_emitting_mean(h, &sol.radiosity);
         let change = self.history.push(means);
         let last = last_level || self.stats.refused_for_memory > 0;
@@ -80,12 +80,12 @@ pub(super) fn estimate_error(
 ) -> (f64, Vec<f64>, Vec<f64>) {
     // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
     let irradiance = config.criterion == refine::Criterion::Irradiance;
-    let results = crate::output::polygon_results(h, sol);
+    let results = crate::solve::polygon_results(h, sol);
     let mut means = vec![results.iter().map(|r| r.b).collect::<Vec<[f64; 3]>>()];
     // The irradiance the user reads adds the luminaires' and distant sources' direct light, which
     // no coarsening changes: it leaves the changes as they are and sets what they are relative to.
     let direct = crate::luminaire::polygon_direct_means(h);
-    let with_direct = |results: Vec<crate::output::PolygonResult>| -> Vec<[f64; 3]> {
+    let with_direct = |results: Vec<crate::solve::PolygonResult>| -> Vec<[f64; 3]> {
         results.iter().enumerate().map(|(p, r)| std::array::from_fn(|c| r.h[c] + direct.get(p).map_or(0.0, |d| d[c]))).collect()
     };
     let mut h_means = vec![with_direct(results.clone())];
@@ -95,7 +95,7 @@ pub(super) fn estimate_error(
             solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error));
         let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
-        let results = crate::output::polygon_results(h, &coarse);
+        let results = crate::solve::polygon_results(h, &coarse);
         means.push(results.iter().map(|r| r.b).collect());
         h_means.push(with_direct(results));
     }

@@ -87,6 +87,22 @@ pub struct Solved {
     pub timings: Timings,
 }
 
+impl crate::points::AsSolveParts for Solved {
+    fn solve_parts(&self) -> crate::points::SolveParts<'_> {
+        crate::points::SolveParts {
+            hierarchy: &self.hierarchy,
+            links: &self.links,
+            solution: &self.solution,
+            lights: &self.lights,
+            caster: &self.caster,
+            convex_enclosure: self.traits.as_ref().is_some_and(|t| !t.needs_visibility),
+            error_estimate: self.error_estimate,
+            polygon_errors: Some(&self.polygon_errors),
+            variation: None,
+        }
+    }
+}
+
 /// The [`Solved`] of a run whose levels ended with `solution` (`None` when no level solved, which
 /// cannot be).
 pub(super) fn assemble(

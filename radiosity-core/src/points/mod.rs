@@ -13,8 +13,9 @@ pub mod grid;
 mod read;
 
 pub use gather::{
-    LeafError, MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET, SAMPLE_SHIFT,
-    SHADOW_DEPTH, SHADOW_EDGE_REL_ERROR, SKY_ERROR_FACTOR, SKY_PROBE_SPREAD, SKY_PROBES, SolveParts, UNIFORM_MAX_SUBTENSE, gather,
+    AsSolveParts, LeafError, MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET,
+    SAMPLE_SHIFT, SHADOW_DEPTH, SHADOW_EDGE_REL_ERROR, SKY_ERROR_FACTOR, SKY_PROBE_SPREAD, SKY_PROBES, SolveParts, UNIFORM_MAX_SUBTENSE,
+    gather,
 };
 pub use grid::{Grid, GridError, GridSpec, GridSummary};
 pub use read::{PointsError, parse_points, read_points};

@@ -341,7 +341,7 @@ pub fn largest_non_emitting_mean(h: &crate::hierarchy::Hierarchy, radiosity: &[[
 pub fn unresolved_per_polygon(h: &crate::hierarchy::Hierarchy, links: &[crate::refine::Link], radiosity: &[[f64; 3]]) -> Vec<[f64; 3]> {
     use rayon::prelude::*;
     let n = h.n_polygons as usize;
-    let by_receiver = super::leaf::LinksByReceiver::new(h, links);
+    let by_receiver = super::by_receiver::LinksByReceiver::new(h, links);
     // Half the range of each whole polygon's radiosity, per channel (zero for subdivided ones).
     let spread: Vec<[f64; 3]> = (0..n)
         .into_par_iter()

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 #[must_use]
 pub fn final_gather(h: &Hierarchy, links: &[Link], radiosity: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let n = h.len();
-    let index = super::leaf::LinksByReceiver::new(h, links);
+    let index = super::by_receiver::LinksByReceiver::new(h, links);
     let leaves: Vec<ElementId> = h.leaves().collect();
     let gathered: Vec<[f64; 3]> = leaves
         .par_iter()

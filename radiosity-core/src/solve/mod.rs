@@ -4,6 +4,7 @@
 //! matrix-free by restarted GMRES, which handles stiff scenes (ρ near 1) in a few dozen products
 //! instead of the O(1/(1−ρ)) sweeps of Jacobi iteration.
 
+mod by_receiver;
 mod cut;
 mod direct;
 mod estimate;
@@ -11,6 +12,7 @@ mod final_gather;
 mod gmres;
 mod leaf;
 mod operator;
+mod polygon;
 mod ranges;
 
 pub use cut::Cut;
@@ -25,6 +27,7 @@ pub use final_gather::{area_means, final_gather, top_down};
 pub use gmres::{GmresResult, gmres};
 pub use leaf::{HALF_MIN_TARGET, HALF_ROUNDING, LEAF_OPERATOR_MAX_BYTES, LeafCoefficients, LeafOperator, Precision, leaf_operator_entries};
 pub use operator::Operator;
+pub use polygon::{PolygonResult, polygon_results};
 pub use ranges::{VALUE_SERIES_FACTOR, element_data, leaf_value_errors};
 
 use crate::hierarchy::Hierarchy;

@@ -11,7 +11,7 @@
 //! much light it sends: what the receiver gets from it is exact with the link's form factor.
 
 use super::Solution;
-use super::leaf::LinksByReceiver;
+use super::by_receiver::LinksByReceiver;
 use crate::formfactor::{MAX_PROBE_PULL, point_to_element};
 use crate::geom::DVec3;
 use crate::hierarchy::{ElementId, Hierarchy, NONE};

@@ -22,12 +22,11 @@ mod prepare;
 mod shadow;
 
 pub use point::{LeafError, SKY_ERROR_FACTOR, SKY_PROBE_SPREAD, SKY_PROBES};
-pub use prepare::SolveParts;
+pub use prepare::{AsSolveParts, SolveParts};
 
 use super::{CalcPoint, PointIrradiance};
 use crate::geom::{DVec3, Poly};
 use crate::hierarchy::{ElementId, Hierarchy};
-use crate::pipeline::Solved;
 use crate::visibility::RayCaster;
 use rayon::prelude::*;
 
@@ -111,7 +110,7 @@ impl Default for PointsConfig {
 /// a convex enclosure ([`crate::analysis::SceneTraits::needs_visibility`]) and the point lies
 /// inside it.
 #[must_use]
-pub fn gather(solved: &Solved, points: &[CalcPoint], config: &PointsConfig) -> Vec<PointIrradiance> {
+pub fn gather<S: AsSolveParts + ?Sized>(solved: &S, points: &[CalcPoint], config: &PointsConfig) -> Vec<PointIrradiance> {
     let g = PointGather::for_solved(solved, config);
     points.par_iter().map(|p| g.irradiance(p)).collect()
 }

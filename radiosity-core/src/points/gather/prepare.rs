@@ -6,7 +6,6 @@ use super::point::on_surface_reach;
 use super::{ON_SURFACE_REL_TOL, PointGather, PointsConfig, Source};
 use crate::geom::{Aabb, DVec3};
 use crate::hierarchy::Hierarchy;
-use crate::pipeline::Solved;
 use crate::visibility::RayCaster;
 
 /// What a gather at points reads of a solve, finished ([`PointGather::for_solved`]) or between
@@ -34,6 +33,14 @@ pub struct SolveParts<'a> {
     /// Each element's radiosity range for this solution ([`crate::solve::element_data`]'s
     /// `variation`), when known already (measured again when `None`).
     pub variation: Option<&'a [f64]>,
+}
+
+/// A finished solve, as a gather at points reads it: the pipeline's `Solved` gives its parts
+/// this way, so that the points (which the pipeline's importance rounds use) need not know the
+/// pipeline.
+pub trait AsSolveParts {
+    /// The parts of the solve a gather reads.
+    fn solve_parts(&self) -> SolveParts<'_>;
 }
 
 impl<'a> PointGather<'a> {
@@ -88,23 +95,12 @@ impl<'a> PointGather<'a> {
         }
     }
 
-    /// Prepares the gather from a solve's hierarchy, radiosity, caster and lights. When the
-    /// solve's analysis found a convex enclosure (no visibility needed), points inside it cast no
-    /// ray.
+    /// Prepares the gather from a solve's hierarchy, radiosity, caster and lights
+    /// ([`AsSolveParts`]; the pipeline's `Solved` is one). When the solve's analysis found a
+    /// convex enclosure (no visibility needed), points inside it cast no ray.
     #[must_use]
-    pub fn for_solved(solved: &'a Solved, config: &PointsConfig) -> PointGather<'a> {
-        let solve = SolveParts {
-            hierarchy: &solved.hierarchy,
-            links: &solved.links,
-            solution: &solved.solution,
-            lights: &solved.lights,
-            caster: &solved.caster,
-            convex_enclosure: solved.traits.as_ref().is_some_and(|t| !t.needs_visibility),
-            error_estimate: solved.error_estimate,
-            polygon_errors: Some(&solved.polygon_errors),
-            variation: None,
-        };
-        PointGather::for_solve(&solve, config)
+    pub fn for_solved<S: AsSolveParts + ?Sized>(solved: &'a S, config: &PointsConfig) -> PointGather<'a> {
+        PointGather::for_solve(&solved.solve_parts(), config)
     }
 
     /// Prepares the gather from the parts of a solve (finished or between its refinements).

@@ -3,12 +3,13 @@
 //! each link's transfer, the source side's weights, the closure of a closed scene, and the value
 //! each link sends. The contract they keep is in the folder's `mod.rs`.
 
-use super::chain::{Chain, LeavesBelow, LinksByReceiver};
+use super::chain::{Chain, LeavesBelow};
 use super::precision::{Precision, Stored, encode};
 use super::weights::{SourceWeights, own_weights, source_weights};
 use super::{CLOSURE_MAX, CLOSURE_MIN, CLOSURE_NOISE_MAX, LeafCoefficients, STREAM_BATCH_ENTRIES, SourceValue, WEIGHT_CHUNK};
 use crate::hierarchy::{ElementId, Hierarchy, NONE};
 use crate::refine::Link;
+use crate::solve::by_receiver::LinksByReceiver;
 use crate::solve::cut::Cut;
 use rayon::prelude::*;
 

@@ -51,7 +51,6 @@ mod operator;
 mod precision;
 mod weights;
 
-pub(super) use chain::LinksByReceiver;
 pub use operator::{LeafOperator, leaf_operator_entries};
 pub use precision::{HALF_MIN_TARGET, HALF_ROUNDING, Precision};
 
