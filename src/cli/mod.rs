@@ -3,8 +3,10 @@
 mod bench;
 mod bench_accuracy;
 mod bench_canopy;
+mod bench_instancing;
 mod bench_reference;
 mod bench_renderpark;
+mod bench_shafts;
 mod generate;
 #[cfg(feature = "mpi")]
 pub mod mpi;
