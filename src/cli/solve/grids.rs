@@ -1,0 +1,31 @@
+//! The grid files of a plain solve: `grid_<name>.csv` and `grid_<name>.svg`, with their figures.
+
+use anyhow::Context;
+use radiosity::output;
+
+/// Writes `grid_<name>.csv` and `grid_<name>.svg` for each grid in the scene's `units` and returns
+/// the figures by name.
+pub(super) fn write_grids(
+    out: &std::path::Path,
+    grids: &[radiosity::points::Grid],
+    results: &[Vec<radiosity::points::PointIrradiance>],
+    units: radiosity::photometry::Units,
+) -> anyhow::Result<std::collections::BTreeMap<String, radiosity::points::GridSummary>> {
+    let mut figures = std::collections::BTreeMap::new();
+    for (g, r) in grids.iter().zip(results) {
+        let name = &g.spec.name;
+        let values: Vec<f64> = r.iter().map(radiosity::points::PointIrradiance::photopic).collect();
+        let errors: Vec<f64> = r.iter().map(radiosity::points::PointIrradiance::photopic_err).collect();
+        let summary = radiosity::points::GridSummary::of(&values)
+            .with_context(|| format!("grid `{name}`: no point, or a value that is not finite"))?
+            .with_errors(&errors);
+        let path = out.join(format!("grid_{name}.csv"));
+        output::atomic::write_file(&path, |w| output::write_grid_csv(w, g, r, units))
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+        let svg = output::grid_svg(g, &values, &summary, units).with_context(|| format!("grid `{name}`: cannot draw the plot"))?;
+        let path = out.join(format!("grid_{name}.svg"));
+        output::atomic::write_bytes(&path, svg).with_context(|| format!("{}: cannot write", path.display()))?;
+        let _ = figures.insert(name.clone(), summary);
+    }
+    Ok(figures)
+}
