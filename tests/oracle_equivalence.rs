@@ -1,7 +1,7 @@
 //! The three releases of the BF oracle (hand-written, DAG runtime, `oracle!`) must make the same
 //! decisions: identical links and bit-identical radiosity on every benchmark scene.
 
-use radiosity::oracle::bench::{self, BenchConfig, same_solution};
+use radiosity::lab::bench::{self, BenchConfig, same_solution};
 use radiosity::oracle::bf::{BfFlat, BfFlatParams, bf_dag};
 use radiosity::oracle::scenes;
 use radiosity::pipeline::{self, Config};

@@ -223,7 +223,7 @@ fn visibility_study_counts_links_per_threshold_and_few_rays_err_more() {
     config.build.min_area_rel = 1e-3;
     let solved = pipeline::run(&scene, &radiosity::refine::BfHand::default(), &config, &|_| {});
     let thresholds = [1e-4, 1e-2, 1.0, f64::INFINITY];
-    let rows = radiosity::oracle::study::visibility_study(&solved, config.visibility, &thresholds);
+    let rows = radiosity::lab::study::visibility_study(&solved, config.visibility, &thresholds);
     assert_eq!(rows.len(), thresholds.len());
     assert_eq!(rows[3].links, solved.links.len() as u64, "an infinite threshold keeps every link");
     for pair in rows.windows(2) {

@@ -92,7 +92,7 @@ fn the_dag_runtime_runs_the_shaft_oracle_as_the_macro_does() {
 /// partly occluded shaft (the boxes stand between the light, the walls and the floor).
 #[test]
 fn the_explained_track_shows_the_shaft() {
-    use radiosity::oracle::{registry, runtime::format_trace};
+    use radiosity::oracle::runtime::format_trace;
     let scene = radiosity::scene::cornell_box();
     let n = scene.polygons.len() as u32;
     let config = Config { levels: 1, ..Config::default() };
@@ -102,7 +102,7 @@ fn the_explained_track_shows_the_shaft() {
             if e == r {
                 continue;
             }
-            let (graph, trace) = registry::explain("shaft", &[], &scene, &config, e, r).expect("built-in oracle");
+            let (graph, trace) = radiosity::lab::explain("shaft", &[], &scene, &config, e, r).expect("built-in oracle");
             if let Some(step) = trace.iter().find(|s| graph.nodes[s.node].tool.name == "ShaftClassify") {
                 let text = format_trace(&graph, &trace);
                 if text.contains("shaft=partial (") {

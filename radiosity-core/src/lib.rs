@@ -10,6 +10,7 @@
 //! - [`solve`]: gather, push-pull, GMRES on the hierarchical operator → radiosity per element
 //! - [`output`]: `image.png`, `solution.ply`, `solution.glb`, `patches.csv`, `stats.json`
 //! - [`points`]: irradiance at calculation points, gathered from the solution → `points.csv`
+//! - [`lab`]: experiments on oracles that run whole solves (benchmark, visibility study, `explain`)
 //! - [`canopy`]: random canopies of black leaves for validation against Beer's law
 //! - [`photometry`]: luminous intensity distributions of luminaires (IES LM-63, EULUMDAT)
 
@@ -20,6 +21,7 @@ pub mod formfactor;
 pub mod geom;
 pub mod hierarchy;
 pub mod instancing;
+pub mod lab;
 pub mod light;
 pub mod luminaire;
 pub mod oracle;

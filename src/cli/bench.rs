@@ -245,7 +245,8 @@ fn bench_leave_out(args: &LeaveOutArgs) -> anyhow::Result<()> {
 }
 
 fn bench_oracle(args: &OracleBenchArgs) -> anyhow::Result<()> {
-    use radiosity::oracle::{bench, scenes};
+    use radiosity::lab::bench;
+    use radiosity::oracle::scenes;
     anyhow::ensure!(args.eps.is_finite() && args.eps > 0.0, "--eps must be positive");
     anyhow::ensure!(args.repeats >= 1, "--repeats must be at least 1");
     let config = bench::BenchConfig { eps: args.eps, repeats: args.repeats, ..bench::BenchConfig::default() };

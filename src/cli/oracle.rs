@@ -63,7 +63,7 @@ pub fn run(cmd: OracleCommand) -> anyhow::Result<()> {
             options.validate()?;
             let scene = load_scene(scene.as_ref(), options.allow_dark)?;
             let params = parse_params(&params)?;
-            let (graph, trace) = registry::explain(&name, &params, &scene, &options.config(), emitter, receiver)?;
+            let (graph, trace) = radiosity::lab::explain(&name, &params, &scene, &options.config(), emitter, receiver)?;
             if trace.is_empty() {
                 println!("the pair {emitter} -> {receiver} was never asked (not a candidate link of this solve)");
             } else {

@@ -1,10 +1,10 @@
-//! `radiosity oracle study`: the visibility study (`radiosity::oracle::study`) on one scene. For
+//! `radiosity oracle study`: the visibility study (`radiosity::lab::study`) on one scene. For
 //! the links of a BF solve whose projected areas lie below each threshold, how often 4, 16 and 64
 //! rays put a link in another visibility class than the reference classifier does: the figures a
 //! `ProjectedAreaBelow` node in front of `RayVisibility` trades against.
 
 use super::{SolveOptions, load_scene};
-use radiosity::oracle::study::{STUDY_RAYS, StudyRow, visibility_study};
+use radiosity::lab::study::{STUDY_RAYS, StudyRow, visibility_study};
 use radiosity::oracle::tools::REFERENCE_RAYS;
 use radiosity::pipeline;
 use std::path::PathBuf;

@@ -1,20 +1,18 @@
 //! Refinement oracles as decision graphs (step 3, `refine`, seen from the oracle's side): the
 //! [`Tool`] trait and the built-in [`tools`], parameters, instrumentation ([`Probe`]), the DAG
-//! runtime ([`runtime`]), the BF oracle in its three releases ([`bf`]), and the benchmark that
-//! compares them ([`mod@bench`]) on procedurally generated scenes ([`scenes`]).
+//! runtime ([`runtime`]), the BF oracle in its three releases ([`bf`]) and the scenes that benchmark
+//! them, procedurally generated ([`scenes`]); the benchmark itself is `crate::lab::bench`.
 //!
 //! The per-link data manager is [`crate::refine::LinkData`]: each slot is filled by the first tool
 //! that asks for it, at the precision it asks (form factor quality, ray count), and reused by
 //! tools asking for less; a graph whose tools never ask for visibility never casts a ray.
 
-pub mod bench;
 pub mod bf;
 mod probe;
 pub mod registry;
 pub mod runtime;
 pub mod scenes;
 pub mod shaft;
-pub mod study;
 pub mod tools;
 
 pub use oracle_graph as graph;

@@ -3,10 +3,8 @@
 
 use super::bf::{BF_TOML, BfFlat, BfFlatParams};
 use super::runtime::{DagOracle, load_graph, parse_graph};
-use super::{NoProbe, ParamError, Recorder, TraceStep, check_param, param_list};
-use crate::pipeline::{self, Config};
+use super::{NoProbe, ParamError, check_param, param_list};
 use crate::refine::{BfHand, BfParams, Oracle};
-use crate::scene::Scene;
 use oracle_graph::Graph;
 use std::path::Path;
 
@@ -101,22 +99,4 @@ pub fn oracle(name: &str, params: &[(String, f64)]) -> Result<Box<dyn Oracle>, R
         }
         _ => Ok(Box::new(DagOracle::new(g, params)?)),
     }
-}
-
-/// What `radiosity oracle explain` shows: the execution track of `emitter → receiver` (element ids)
-/// when `scene` is solved with the graph of oracle `name`, interpreted by the DAG runtime with a
-/// recorder (decisions are the same as the named release's). Empty when the pair is never asked.
-pub fn explain(
-    name: &str,
-    params: &[(String, f64)],
-    scene: &Scene,
-    config: &Config,
-    emitter: u32,
-    receiver: u32,
-) -> Result<(Graph, Vec<TraceStep>), RegistryError> {
-    let g = graph(name)?;
-    let probe = Recorder::new(g.nodes.len()).tracing(emitter, receiver);
-    let dag = DagOracle::with_probe(g.clone(), params, Vec::new(), probe)?;
-    let _ = pipeline::run(scene, &dag, config, &|_| {});
-    Ok((g, dag.probe().trace()))
 }

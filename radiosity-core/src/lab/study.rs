@@ -1,9 +1,9 @@
 //! The visibility study: for the links of a BF solution whose areas projected along the link are
 //! below a threshold, classify visibility with 4, 16 and 64 rays beside the reference classifier
-//! ([`super::tools::ReferenceVisibility`]) and count disagreements.
+//! ([`crate::oracle::tools::ReferenceVisibility`]) and count disagreements.
 
-use super::Tool;
-use super::tools::{RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};
+use crate::oracle::Tool;
+use crate::oracle::tools::{RayVisibility, ReferenceClass, ReferenceVisibility, VisibilityClass};
 use crate::pipeline::Solved;
 use crate::refine::{LinkCtx, Services};
 use crate::visibility::VisibilityConfig;

@@ -1,7 +1,7 @@
 //! The three releases of the BF oracle side by side (hand-written, DAG runtime, `oracle!`), on the
 //! same scenes in one process: refinement time of each and whether they agree bit for bit.
 
-use super::bf::{BfFlat, BfFlatParams, bf_dag};
+use crate::oracle::bf::{BfFlat, BfFlatParams, bf_dag};
 use crate::pipeline::{self, Config, Solved};
 use crate::refine::{BfHand, BfParams, Oracle};
 use crate::scene::Scene;
