@@ -30,12 +30,22 @@
 //! (first members) of the classes found so far in its bucket, in order, and joins the first that
 //! matches. Classes with at least [`AutoOptions::min_copies`] members become prototypes whose local
 //! frame is the representative's, centred on its centroid. The output is deterministic.
+//!
+//! # Layout
+//! This file holds the settings, the report and [`auto_instance`] (classes to prototypes and
+//! instances); `objects` the objects of the input and the figures they are compared by (step 1),
+//! `matching` the candidate transforms and their verification (steps 2 and 3).
+
+mod matching;
+mod objects;
 
 use super::flatten::{FlattenOptions, for_each_polygon};
 use super::model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
-use crate::geom::{DVec3, Poly};
+use crate::geom::Poly;
 use crate::scene::Scene;
 use glam::{DMat3, DMat4};
+use matching::{Match, find_rigid_match};
+use objects::collect_objects;
 use std::collections::BTreeMap;
 
 /// Largest distance between a vertex mapped by the candidate transform and its match, relative to
@@ -221,217 +231,6 @@ pub fn flattened_polygons(scene: &InstancedScene) -> Vec<(Poly, u32)> {
     out
 }
 
-/// One OBJ object / group: its polygons in input order and, when comparable, its shape.
-struct Object {
-    group: u32,
-    first: u32,
-    polygons: Vec<u32>,
-    shape: Option<Shape>,
-}
-
-/// What comparisons need of an object.
-struct Shape {
-    signature: Vec<(u32, u8)>,
-    centroid: DVec3,
-    /// Largest vertex distance from the centroid.
-    radius: f64,
-    area: f64,
-    /// Trace and Frobenius norm of the area-weighted vertex covariance, per unit weight.
-    cov_trace: f64,
-    cov_norm: f64,
-    /// Distinct vertices.
-    vertices: Vec<DVec3>,
-}
-
-fn collect_objects(scene: &Scene) -> Vec<Object> {
-    let mut by_group: BTreeMap<u32, usize> = BTreeMap::new();
-    let mut objects: Vec<Object> = Vec::new();
-    for (i, p) in scene.polygons.iter().enumerate() {
-        let idx = *by_group.entry(p.group).or_insert_with(|| {
-            objects.push(Object { group: p.group, first: i as u32, polygons: Vec::new(), shape: None });
-            objects.len() - 1
-        });
-        objects[idx].polygons.push(i as u32);
-    }
-    for o in &mut objects {
-        o.shape = shape_of(scene, &o.polygons);
-    }
-    objects
-}
-
-fn shape_of(scene: &Scene, polygons: &[u32]) -> Option<Shape> {
-    let mut signature = Vec::with_capacity(polygons.len());
-    let (mut wsum, mut csum, mut area) = (0.0, DVec3::ZERO, 0.0);
-    for &i in polygons {
-        let p = &scene.polygons[i as usize];
-        if p.material as usize >= scene.materials.len() || p.poly.vertices().iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        signature.push((p.material, p.poly.n_vertices() as u8));
-        let a = p.poly.area();
-        area += a;
-        for &v in p.poly.vertices() {
-            let w = a / p.poly.n_vertices() as f64;
-            wsum += w;
-            csum += w * v;
-        }
-    }
-    signature.sort_unstable();
-    if !wsum.is_finite() || wsum <= 0.0 || !area.is_finite() {
-        return None;
-    }
-    let centroid = csum / wsum;
-    let mut cov = [[0.0f64; 3]; 3];
-    let mut radius = 0.0f64;
-    let mut vertices = Vec::new();
-    for &i in polygons {
-        let p = &scene.polygons[i as usize];
-        let w = p.poly.area() / p.poly.n_vertices() as f64 / wsum;
-        for &v in p.poly.vertices() {
-            let d = (v - centroid).to_array();
-            for (r, row) in cov.iter_mut().enumerate() {
-                for (c, x) in row.iter_mut().enumerate() {
-                    *x += w * d[r] * d[c];
-                }
-            }
-            radius = radius.max((v - centroid).length());
-            vertices.push(v);
-        }
-    }
-    vertices.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)).then(a.z.total_cmp(&b.z)));
-    vertices.dedup();
-    let cov_trace = cov[0][0] + cov[1][1] + cov[2][2];
-    let cov_norm = cov.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
-    if !radius.is_finite() || radius <= 0.0 {
-        return None;
-    }
-    Some(Shape { signature, centroid, radius, area, cov_trace, cov_norm, vertices })
-}
-
-enum Match {
-    /// The rotation (the translation follows from the centroids) and, for every polygon of the
-    /// representative in its order, the matching input polygon.
-    Found(DMat3, Vec<u32>),
-    Different,
-    GaveUp,
-}
-
-/// Whether `b` is `a` moved rigidly, within `rel_tol`.
-fn find_rigid_match(scene: &Scene, a: &Object, sa: &Shape, b: &Object, sb: &Shape, rel_tol: f64) -> Match {
-    let r = sa.radius.max(sb.radius);
-    let tol = rel_tol * r;
-    let loose = FILTER_TOL_FACTOR * rel_tol;
-    let close = |x: f64, y: f64, scale: f64| (x - y).abs() <= loose * scale;
-    if sa.signature != sb.signature
-        || !close(sa.radius, sb.radius, r)
-        || !close(sa.area, sb.area, sa.area.max(sb.area))
-        || !close(sa.cov_trace, sb.cov_trace, r * r)
-        || !close(sa.cov_norm, sb.cov_norm, r * r)
-    {
-        return Match::Different;
-    }
-    // B's anchors: the farthest vertex, then the vertex farthest from the line through it.
-    let (cb, ca) = (sb.centroid, sa.centroid);
-    let Some(&p1) = sb.vertices.iter().max_by(|x, y| (**x - cb).length().total_cmp(&(**y - cb).length())) else {
-        return Match::Different;
-    };
-    let axis = (p1 - cb).normalize_or_zero();
-    let off_axis = |v: DVec3| (v - cb).reject_from_normalized(axis).length();
-    let Some(&p2) = sb.vertices.iter().max_by(|x, y| off_axis(**x).total_cmp(&off_axis(**y))) else {
-        return Match::Different;
-    };
-    if axis == DVec3::ZERO || off_axis(p2) <= tol {
-        return Match::Different;
-    }
-    let Some(fb) = frame(cb, p1, p2) else { return Match::Different };
-    let (d1, d2, d12) = ((p1 - cb).length(), (p2 - cb).length(), (p2 - p1).length());
-    // Distances are compared with twice the tolerance: both objects carry vertex noise.
-    let near = |x: f64, y: f64| (x - y).abs() <= 2.0 * tol;
-    let b_lookup = PolygonLookup::new(scene, &b.polygons);
-    let mut tried = 0usize;
-    for &q1 in sa.vertices.iter().filter(|&&q| near((q - ca).length(), d1)) {
-        for &q2 in sa.vertices.iter().filter(|&&q| near((q - ca).length(), d2) && near((q - q1).length(), d12)) {
-            let Some(fa) = frame(ca, q1, q2) else { continue };
-            if tried == MAX_FRAME_CANDIDATES {
-                return Match::GaveUp;
-            }
-            tried += 1;
-            let rot = fb * fa.transpose();
-            if let Some(map) = verify(scene, a, ca, &rot, cb, &b_lookup, tol) {
-                return Match::Found(rot, map);
-            }
-        }
-    }
-    Match::Different
-}
-
-/// Right-handed orthonormal frame (columns) from a centre and two non-collinear points.
-fn frame(c: DVec3, p1: DVec3, p2: DVec3) -> Option<DMat3> {
-    let u = (p1 - c).try_normalize()?;
-    let v = (p2 - c).reject_from_normalized(u).try_normalize()?;
-    Some(DMat3::from_cols(u, v, u.cross(v)))
-}
-
-/// B's polygons sorted by the x of their centroid, for window searches.
-struct PolygonLookup {
-    /// `(centroid, input polygon index)`, sorted by `centroid.x`.
-    entries: Vec<(DVec3, u32)>,
-}
-
-impl PolygonLookup {
-    fn new(scene: &Scene, polygons: &[u32]) -> PolygonLookup {
-        let mut entries: Vec<(DVec3, u32)> = polygons.iter().map(|&i| (vertex_mean(&scene.polygons[i as usize].poly), i)).collect();
-        entries.sort_by(|x, y| x.0.x.total_cmp(&y.0.x).then(x.1.cmp(&y.1)));
-        PolygonLookup { entries }
-    }
-}
-
-/// Mean of the vertices (moves with the vertices, unlike an area centroid it needs no area).
-fn vertex_mean(p: &Poly) -> DVec3 {
-    let v = p.vertices();
-    v.iter().copied().sum::<DVec3>() / v.len() as f64
-}
-
-/// Maps every polygon of `a` by `x ↦ rot·(x − ca) + cb` and finds a distinct polygon of B with the
-/// same material, vertex count and vertices (some cyclic rotation) within `tol`. Returns B's
-/// polygon for each of A's, in A's order.
-fn verify(scene: &Scene, a: &Object, ca: DVec3, rot: &DMat3, cb: DVec3, b: &PolygonLookup, tol: f64) -> Option<Vec<u32>> {
-    let mut used = vec![false; b.entries.len()];
-    let mut map = Vec::with_capacity(a.polygons.len());
-    let mut mapped = [DVec3::ZERO; 4];
-    for &ia in &a.polygons {
-        let pa = &scene.polygons[ia as usize];
-        let n = pa.poly.n_vertices();
-        for (m, &v) in mapped.iter_mut().zip(pa.poly.vertices()) {
-            *m = *rot * (v - ca) + cb;
-        }
-        let mean = mapped[..n].iter().copied().sum::<DVec3>() / n as f64;
-        let start = b.entries.partition_point(|e| e.0.x < mean.x - tol);
-        let mut found = None;
-        for (k, &(cen, ib)) in b.entries.iter().enumerate().skip(start) {
-            if cen.x > mean.x + tol {
-                break;
-            }
-            if used[k] || (cen - mean).length() > tol {
-                continue;
-            }
-            let pb = &scene.polygons[ib as usize];
-            if pb.material != pa.material || pb.poly.n_vertices() != n {
-                continue;
-            }
-            let vb = pb.poly.vertices();
-            if (0..n).any(|shift| (0..n).all(|j| (mapped[j] - vb[(j + shift) % n]).length() <= tol)) {
-                found = Some(k);
-                break;
-            }
-        }
-        let k = found?;
-        used[k] = true;
-        map.push(b.entries[k].1);
-    }
-    Some(map)
-}
-
 fn group_name(scene: &Scene, group: u32) -> String {
     scene.groups.get(group as usize).cloned().unwrap_or_else(|| format!("group{group}"))
 }
@@ -451,6 +250,7 @@ fn unique_name(base: &str, taken: &[Prototype]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::DVec3;
     use crate::scene::{Material, Polygon};
 
     fn scene_of(objects: &[Vec<Poly>]) -> Scene {
