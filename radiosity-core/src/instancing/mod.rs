@@ -60,7 +60,6 @@
 
 pub mod auto;
 pub mod balance;
-pub mod bands;
 pub mod bench;
 pub mod caster;
 mod error;
@@ -80,7 +79,7 @@ pub use auto::{AutoOptions, AutoReport, AutoResult, auto_instance};
 pub use caster::InstanceCaster;
 pub use error::InstancingError;
 pub use flatten::{FlattenOptions, flatten, flatten_prototype};
-pub use format::{Lighting, LuminaireSpec, load, load_with_lighting, parse, parse_with_lighting};
+pub use format::{Lighting, LuminaireSpec, bands, load, load_with_lighting, parse, parse_with_lighting};
 pub use model::{Instance, InstancedScene, LocalPolygon, Prototype, PrototypeId, Transform};
 pub use output::{StreamedOutput, StreamedSummary};
 pub use plant::{ForestParams, TreeParams, generate_forest, generate_tree};

@@ -6,10 +6,10 @@
 //! solve of its own with the materials and sources of its bands, so the cost grows with the
 //! number of bands (by thirds). Without `bands` the three channels are red, green and blue.
 
-use super::InstancingError;
-use super::format::ColorSpec;
+use super::spec::ColorSpec;
 use crate::daylight::{self, DistantSource, Site, SkyModel};
 use crate::geom::DVec3;
+use crate::instancing::InstancingError;
 use crate::scene::Material;
 use serde::Deserialize;
 use std::path::Path;
