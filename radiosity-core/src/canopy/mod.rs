@@ -20,12 +20,17 @@
 //! [`write_scene_file`] writes a canopy as a scene file (TOML with the leaves in an OBJ file, a
 //! ground, a `[sun]`, a `[sky]` and a calculation grid below the canopy's centre).
 
+mod beer;
+mod scene_file;
+
+pub use beer::{beam_transmittance, diffuse_transmittance, expint_e3, finite_beam_transmittance, sky_transmittance};
+pub use scene_file::{SceneFileOptions, write_scene_file};
+
 use crate::daylight::DistantSource;
 use crate::geom::DVec3;
 use crate::scene::{Material, Scene, SceneBuilder};
 use crate::visibility::Rng;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The G-function of the spherical leaf-angle distribution: the mean area of a unit leaf's shadow
 /// on a plane across the beam, whatever the beam's direction.
@@ -215,227 +220,6 @@ impl Canopy {
         let at = |i: u32| if i == tiles { half } else { -half + step * f64::from(i) };
         (0..tiles).flat_map(|j| (0..tiles).map(move |i| (at(i), at(j), at(i + 1), at(j + 1)))).collect()
     }
-}
-
-/// `exp(−G·LAI/cos θ)`: the fraction of a parallel beam at zenith angle `zenith` (radians) that
-/// a random canopy of spherical leaf-angle distribution transmits, in the continuum limit.
-#[must_use]
-pub fn beam_transmittance(lai: f64, zenith: f64) -> f64 {
-    (-G_SPHERICAL * lai / zenith.cos()).exp()
-}
-
-/// `(1 − G·a/(A·cos θ))^N`: the expected fraction transmitted by `n` leaves of area `leaf_area`
-/// placed at random over ground area `ground_area`, away from the canopy's edge.
-#[must_use]
-pub fn finite_beam_transmittance(n: usize, leaf_area: f64, ground_area: f64, zenith: f64) -> f64 {
-    let p = G_SPHERICAL * leaf_area / (ground_area * zenith.cos());
-    (1.0 - p).powf(n as f64)
-}
-
-/// `2·E₃(G·LAI)`: the fraction of a uniform sky's light (continuous) that the canopy transmits.
-#[must_use]
-pub fn diffuse_transmittance(lai: f64) -> f64 {
-    2.0 * expint_e3(G_SPHERICAL * lai)
-}
-
-/// `Σ_i w_i·exp(−G·LAI/μ_i)`: the fraction of a sky of distant sources (see
-/// [`crate::daylight::sky`]; z up) that the canopy transmits, `w_i` each source's share of the
-/// horizontal irradiance, `μ_i` the cosine of its zenith angle.
-#[must_use]
-pub fn sky_transmittance(sources: &[DistantSource], lai: f64) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for s in sources {
-        let w = s.on(DVec3::Z)[0];
-        let mu = -s.toward.z;
-        if w > 0.0 && mu > 0.0 {
-            num += w * (-G_SPHERICAL * lai / mu).exp();
-            den += w;
-        }
-    }
-    if den > 0.0 { num / den } else { 0.0 }
-}
-
-/// The exponential integral `E₃(x) = ∫₁^∞ e^(−xt)/t³ dt` for `x ≥ 0`, from `E₁` (its series for
-/// `x ≤ 1`, its continued fraction beyond, both to double precision) by the recurrence
-/// `E_(n+1)(x) = (e^(−x) − x·E_n(x))/n`. `E₃(0) = 1/2`.
-#[must_use]
-pub fn expint_e3(x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.5;
-    }
-    let e1 = if x <= 1.0 {
-        // E₁(x) = −γ − ln x − Σ_{k≥1} (−x)^k / (k·k!)
-        let mut sum = 0.0;
-        let mut term = 1.0;
-        for k in 1..60 {
-            term *= -x / f64::from(k);
-            let add = term / f64::from(k);
-            sum += add;
-            if add.abs() < 1e-17 * sum.abs().max(1e-300) {
-                break;
-            }
-        }
-        -0.577_215_664_901_532_9 - x.ln() - sum
-    } else {
-        // Modified Lentz on E₁(x) = e^(−x) · 1/(x + 1 − 1²/(x + 3 − 2²/(x + 5 − ...)))
-        let tiny = 1e-300;
-        let mut b = x + 1.0;
-        let mut c = 1.0 / tiny;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        for i in 1..200 {
-            let a = -f64::from(i) * f64::from(i);
-            b += 2.0;
-            d = 1.0 / (a * d + b);
-            c = b + a / c;
-            let del = c * d;
-            h *= del;
-            if (del - 1.0).abs() < 1e-16 {
-                break;
-            }
-        }
-        h * (-x).exp()
-    };
-    let e2 = (-x).exp() - x * e1;
-    ((-x).exp() - x * e2) / 2.0
-}
-
-/// What [`write_scene_file`] puts around the leaves.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SceneFileOptions {
-    /// Ground reflectance.
-    pub ground_reflectance: f64,
-    /// The sun's zenith angle, degrees (below 90).
-    pub sun_zenith: f64,
-    /// The sun's azimuth, degrees clockwise from north (+y).
-    pub sun_azimuth: f64,
-    /// Direct normal irradiance, W/m² (0: no `[sun]`).
-    pub direct_normal: f64,
-    /// Diffuse horizontal irradiance of a uniform sky, W/m² (0: no `[sky]`).
-    pub diffuse_horizontal: f64,
-    /// Spacing of the calculation grid below the canopy's centre.
-    pub grid_spacing: f64,
-}
-
-impl Default for SceneFileOptions {
-    fn default() -> Self {
-        SceneFileOptions {
-            ground_reflectance: 0.0,
-            sun_zenith: 30.0,
-            sun_azimuth: 180.0,
-            direct_normal: 800.0,
-            diffuse_horizontal: 100.0,
-            grid_spacing: 0.25,
-        }
-    }
-}
-
-/// Writes `canopy.toml` and `leaves.obj` into `dir` (created if missing): the leaves (black), a
-/// ground, the sun and a uniform 145-cell sky as `options` says, and a calculation grid `below`
-/// on the ground, inside [`Canopy::margin`] of the sun's zenith angle. The file's header states
-/// the parameters and what theory expects. Returns the scene file's path.
-pub fn write_scene_file(canopy: &Canopy, options: &SceneFileOptions, dir: &Path) -> Result<PathBuf, CanopyError> {
-    let o = options;
-    if !(0.0..90.0).contains(&o.sun_zenith) {
-        return Err(CanopyError(format!("sun zenith {} must be in [0, 90) degrees", o.sun_zenith)));
-    }
-    if !o.sun_azimuth.is_finite() {
-        return Err(CanopyError(format!("sun azimuth {} is not finite", o.sun_azimuth)));
-    }
-    for (what, v) in [("direct normal irradiance", o.direct_normal), ("diffuse horizontal irradiance", o.diffuse_horizontal)] {
-        if !v.is_finite() || v < 0.0 {
-            return Err(CanopyError(format!("{what} must be finite and non-negative, got {v}")));
-        }
-    }
-    if !(o.ground_reflectance.is_finite() && (0.0..1.0).contains(&o.ground_reflectance)) {
-        return Err(CanopyError(format!("ground reflectance {} must be in [0, 1)", o.ground_reflectance)));
-    }
-    if !o.grid_spacing.is_finite() || o.grid_spacing <= 0.0 {
-        return Err(CanopyError(format!("grid spacing must be positive, got {}", o.grid_spacing)));
-    }
-    let p = &canopy.params;
-    let zenith = o.sun_zenith.to_radians();
-    let half = 0.5 * p.extent - canopy.margin(zenith);
-    if half <= 0.0 {
-        return Err(CanopyError(format!(
-            "the canopy is too small for a sun {} degrees from the zenith: nothing below it is farther than {:.3} from its edge",
-            o.sun_zenith,
-            canopy.margin(zenith)
-        )));
-    }
-    let lai = canopy.lai();
-    let site = crate::daylight::Site::default();
-    let toward = -site.direction(zenith, o.sun_azimuth.to_radians());
-    let sky = crate::daylight::sky(crate::daylight::SkyModel::Uniform, [1.0; 3], 145, &site).map_err(|e| CanopyError(e.to_string()))?;
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "# A random canopy (radiosity generate canopy): {} black square leaves of side {}, normals uniform",
-        canopy.leaves.len(),
-        p.leaf_size
-    );
-    let _ = writeln!(
-        t,
-        "# over the sphere (G = {G_SPHERICAL}), centres uniform in x, y in [-{h}, {h}], z in [{}, {}]; seed {}.",
-        p.base,
-        p.base + p.height,
-        p.seed,
-        h = 0.5 * p.extent
-    );
-    let _ = writeln!(t, "# Leaf area index {lai:.6}. Theory, below the canopy farther than the margin from its edge:");
-    let _ = writeln!(
-        t,
-        "#   sun at zenith {} deg: exp(-G*LAI/cos) = {:.6} of the direct light (grid `below` is inside the margin {:.4})",
-        o.sun_zenith,
-        beam_transmittance(lai, zenith),
-        canopy.margin(zenith)
-    );
-    let _ = writeln!(
-        t,
-        "#   uniform sky: 2*E3(G*LAI) = {:.6} continuous, {:.6} for the 145-cell sky (the margin for its lowest cells is wider)",
-        diffuse_transmittance(lai),
-        sky_transmittance(&sky, lai)
-    );
-    let _ = writeln!(t, "name = \"canopy\"\nobj = \"leaves.obj\"\n");
-    let _ = writeln!(t, "[[material]]\nname = \"leaf\"\nreflectance = 0.0\n");
-    let _ = writeln!(t, "[[material]]\nname = \"ground\"\nreflectance = {}\n", o.ground_reflectance);
-    let e = 0.5 * p.extent;
-    let _ = writeln!(
-        t,
-        "[[polygon]]\nmaterial = \"ground\"\nvertices = [[{m}, {m}, 0.0], [{e}, {m}, 0.0], [{e}, {e}, 0.0], [{m}, {e}, 0.0]]\n",
-        m = -e
-    );
-    if o.direct_normal > 0.0 {
-        let _ =
-            writeln!(t, "[sun]\ndirection = [{:.12}, {:.12}, {:.12}]\ndirect_normal = {}\n", toward.x, toward.y, toward.z, o.direct_normal);
-    }
-    if o.diffuse_horizontal > 0.0 {
-        let _ = writeln!(t, "[sky]\nmodel = \"uniform\"\ndiffuse_horizontal = {}\ndirections = 145\n", o.diffuse_horizontal);
-    }
-    let _ = writeln!(
-        t,
-        "[[grid]]\nname = \"below\"\norigin = [{m}, {m}, 0.0]\nu = [{w}, 0.0, 0.0]\nv = [0.0, {w}, 0.0]\nspacing = {}\nnormal = [0.0, 0.0, 1.0]",
-        o.grid_spacing,
-        m = -half,
-        w = 2.0 * half
-    );
-    let mut obj = String::with_capacity(canopy.leaves.len() * 170);
-    let _ = writeln!(obj, "# {} leaves, z up\no leaves\nusemtl leaf", canopy.leaves.len());
-    for q in &canopy.leaves {
-        for v in q {
-            let _ = writeln!(obj, "v {:.9} {:.9} {:.9}", v.x, v.y, v.z);
-        }
-    }
-    for k in 0..canopy.leaves.len() {
-        let i = 4 * k + 1;
-        let _ = writeln!(obj, "f {} {} {} {}", i, i + 1, i + 2, i + 3);
-    }
-    std::fs::create_dir_all(dir).map_err(|e| CanopyError(format!("cannot create {}: {e}", dir.display())))?;
-    let path = dir.join("canopy.toml");
-    std::fs::write(&path, t).map_err(|e| CanopyError(format!("cannot write {}: {e}", path.display())))?;
-    let obj_path = dir.join("leaves.obj");
-    std::fs::write(&obj_path, obj).map_err(|e| CanopyError(format!("cannot write {}: {e}", obj_path.display())))?;
-    Ok(path)
 }
 
 #[cfg(test)]
