@@ -43,7 +43,14 @@ pub fn point_polygon_unclipped(x: DVec3, n: DVec3, poly: &[DVec3]) -> f64 {
         if len == 0.0 {
             continue;
         }
-        let theta = len.atan2(a.dot(b));
+        let d = a.dot(b);
+        let theta = if d > 0.0 {
+            (len / d).atan()
+        } else if d < 0.0 {
+            std::f64::consts::PI - (len / -d).atan()
+        } else {
+            std::f64::consts::FRAC_PI_2
+        };
         sum += theta * n.dot(c) / len;
     }
     sum / (2.0 * std::f64::consts::PI)

@@ -75,7 +75,7 @@ pub(super) fn source_weights(h: &Hierarchy, links: &[Link], below: &LeavesBelow,
 pub(super) fn shape_form_factor(h: &Hierarchy, source: ElementId, leaf: ElementId) -> f64 {
     let (s, e) = (h.get(source), h.get(leaf));
     let separation = (s.center - e.center).length() / (s.radius + e.radius).max(f64::MIN_POSITIVE);
-    if separation >= WEIGHT_FAR_SEPARATION && !formfactor::behind_surface(s, e.poly().map(|p| p.vertices().to_vec()).unwrap_or_default()) {
+    if separation >= WEIGHT_FAR_SEPARATION && !formfactor::behind_surface(s, e.poly().map_or(&[][..], |p| p.vertices()).iter().copied()) {
         formfactor::point_to_element(h, e.center, e.normal, source)
     } else if separation >= formfactor::NEAR_SEPARATION && e.poly().is_some() && s.poly().is_some() {
         formfactor::link_form_factor(h, source, leaf, FormFactorQuality::Shape)
