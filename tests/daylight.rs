@@ -188,7 +188,7 @@ fn four_bands_are_two_solves_that_agree_with_one() {
 #[test]
 fn bad_daylight_input_is_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &str); 6] = [
+    let cases: [(&str, &str); 10] = [
         (
             "bands = [\"PAR\", \"NIR\"]\n[[material]]\nname = \"m\"\nreflectance = [0.1, 0.2, 0.3]\n",
             "3 values given, the scene has 2 bands",
@@ -198,6 +198,16 @@ fn bad_daylight_input_is_one_clear_line() {
         ("[sun]\ndirect_normal = 100\n", "give either `direction`, or `latitude`, `longitude` and `time`"),
         ("[sun]\nlatitude = 43.6\nlongitude = 3.9\ntime = \"tomorrow\"\ndirect_normal = 100\n", "not RFC 3339"),
         ("[sky]\ndiffuse_horizontal = 100\ndirections = 0\n", "sky directions 0"),
+        ("[sky]\nmodel = \"cie-general\"\ntype = 12\ndiffuse_horizontal = 100\n", "needs the sun's position"),
+        (
+            "[sun]\ndirection = [0, 0.5, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"cie-general\"\ndiffuse_horizontal = 100\n",
+            "needs `type` (1 to 15)",
+        ),
+        (
+            "[sun]\ndirection = [0, 0.5, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"cie-general\"\ntype = 16\ndiffuse_horizontal = 100\n",
+            "type 16: give 1 to 15",
+        ),
+        ("[sky]\nmodel = \"uniform\"\ntype = 3\ndiffuse_horizontal = 100\n", "`type` applies to model = \"cie-general\" only"),
     ];
     for (i, (text, expected)) in cases.iter().enumerate() {
         let name = format!("bad{i}.toml");
@@ -209,6 +219,20 @@ fn bad_daylight_input_is_one_clear_line() {
         assert_eq!(err.trim().lines().count(), 1, "{name}: {err}");
         assert!(!err.contains("panicked"));
     }
+}
+
+/// A CIE general sky from the scene file (type 12, the standard clear sky, its sun given by
+/// `[sun]` with no beam): an open ground receives the diffuse horizontal irradiance exactly.
+#[test]
+fn a_cie_general_sky_lights_an_open_ground_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let sky =
+        "[sun]\ndirection = [0.0, 0.6, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"cie-general\"\ntype = 12\ndiffuse_horizontal = 100\n";
+    let s = solve(dir.path(), &format!("{GROUND}{sky}"));
+    assert!((s["power_incident"].as_f64().unwrap() - 10_000.0).abs() < EXACT_TOL * 10_000.0, "{}", s["power_incident"]);
+    let (header, rows) = csv(&dir.path().join("out/patches.csv"));
+    let h = rows[0][column(&header, "h_g")].parse::<f64>().unwrap();
+    assert!((h - 100.0).abs() < EXACT_TOL * 100.0, "irradiance {h}");
 }
 
 /// A small tilted square held a metre over a black ground under the sun alone: the ground's mean

@@ -53,19 +53,31 @@ pub(super) struct SunSpec {
     direct_normal: ColorSpec,
 }
 
-/// `[sky]`: a radiance model, the diffuse horizontal irradiance and the number of cells.
+/// `[sky] model`: the radiance distribution's name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub(super) enum SkyModelName {
+    Uniform,
+    CieOvercast,
+    CieGeneral,
+}
+
+/// `[sky]`: a radiance model (a CIE general sky with its `type`), the diffuse horizontal
+/// irradiance and the number of cells.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SkySpec {
     #[serde(default = "model_default")]
-    model: SkyModel,
+    model: SkyModelName,
+    #[serde(default, rename = "type")]
+    sky_type: Option<u8>,
     diffuse_horizontal: ColorSpec,
     #[serde(default = "directions_default")]
     directions: u32,
 }
 
-fn model_default() -> SkyModel {
-    SkyModel::Uniform
+fn model_default() -> SkyModelName {
+    SkyModelName::Uniform
 }
 
 fn directions_default() -> u32 {
@@ -270,7 +282,27 @@ pub(super) fn resolve(input: &BandsInput<'_>, path: &Path, line: usize) -> Resul
             return Err(InstancingError::at(path, line, format!("[sky]: diffuse_horizontal {dhi:?} must be finite and non-negative")));
         }
         daylight::sky_cells(s.directions).map_err(|e| InstancingError::at(path, line, format!("[sky]: {e}")))?;
-        sky = Some((s.model, dhi, s.directions));
+        let model = sky_model(s, sun_report.as_ref(), &site).map_err(|e| InstancingError::at(path, line, format!("[sky]: {e}")))?;
+        sky = Some((model, dhi, s.directions));
     }
     Ok(Bands { names, declared: input.bands.is_some(), materials, site, sun, sun_report, sky })
+}
+
+/// The sky model `[sky]` names; a CIE general sky takes the sun's position from `[sun]`.
+fn sky_model(s: &SkySpec, sun: Option<&SunReport>, site: &Site) -> Result<SkyModel, String> {
+    match (s.model, s.sky_type) {
+        (SkyModelName::Uniform, None) => Ok(SkyModel::Uniform),
+        (SkyModelName::CieOvercast, None) => Ok(SkyModel::CieOvercast),
+        (SkyModelName::CieGeneral, Some(t)) => {
+            let Some(sun) = sun else {
+                return Err("model \"cie-general\" needs the sun's position: give [sun] (`direct_normal = 0` leaves its beam out)".into());
+            };
+            let to_sun = -DVec3::from(sun.toward);
+            let zenith = to_sun.dot(site.up).clamp(-1.0, 1.0).acos();
+            let azimuth = to_sun.dot(site.east()).atan2(to_sun.dot(site.north));
+            Ok(SkyModel::CieGeneral(daylight::CieSky::new(t, zenith, azimuth).map_err(|e| e.to_string())?))
+        }
+        (SkyModelName::CieGeneral, None) => Err("model \"cie-general\" needs `type` (1 to 15)".into()),
+        (_, Some(_)) => Err("`type` applies to model = \"cie-general\" only".into()),
+    }
 }
