@@ -7,53 +7,46 @@ use super::{CORNER_INSET, MAX_ANGULAR_SIZE};
 use crate::geom::quadrature::element_rule;
 use crate::geom::{DVec3, quadrature};
 
+/// What lights one surface leaf, and how it faces: its polygon and normal, the luminaires, the
+/// distant sources and, with visibility on, the sharp sources' exact shadows.
+#[derive(Clone, Copy)]
+pub(super) struct LeafSources<'a> {
+    pub(super) normal: DVec3,
+    pub(super) polygon: u32,
+    pub(super) light: &'a DirectLight<'a>,
+    pub(super) distant: &'a crate::daylight::DistantLight<'a>,
+    pub(super) shadows: Option<&'a ParallelShadows<'a>>,
+}
+
 /// A surface leaf's direct irradiance and the error estimated in it: where its rule may be
 /// inaccurate ([`rule_direct`]), the mean of the rule over its pieces quartered `depth` times
 /// (at least once), the error its difference from the same quartered one fewer time; elsewhere
 /// the rule's, with no error. The soft sources' light is `inherited` where given (its parent's,
 /// seen the same all over it), and comes back where the leaf's pieces may take it
 /// ([`Hierarchy::direct_soft`](crate::hierarchy::Hierarchy::direct_soft)).
-#[expect(clippy::too_many_arguments, reason = "the element, its sources and its quadrature, each read by the rule")]
-pub(super) fn leaf_direct(
-    poly: &crate::geom::Poly,
-    normal: DVec3,
-    polygon: u32,
-    light: &DirectLight<'_>,
-    distant: &crate::daylight::DistantLight<'_>,
-    shadows: Option<&ParallelShadows<'_>>,
-    depth: u32,
-    inherited: Option<[f64; 3]>,
-) -> LeafDirect {
-    let rule = rule_direct(poly, normal, polygon, light, distant, shadows, false, inherited);
+pub(super) fn leaf_direct(poly: &crate::geom::Poly, at: &LeafSources<'_>, depth: u32, inherited: Option<[f64; 3]>) -> LeafDirect {
+    let rule = rule_direct(poly, at, false, inherited);
     let (soft, edge) = (rule.soft_uniform.then_some(rule.soft), rule.edge);
     if !rule.crossed || depth == 0 {
         return LeafDirect { direct: rule.total(), error: [0.0; 3], soft, edge };
     }
     // The sky's cells cast soft shadows: the rule holds for them, and only the sharp sources are
     // sampled on the pieces.
-    let coarse = if depth == 1 { rule.sharp } else { pieces_direct(poly, normal, polygon, light, distant, shadows, depth - 1) };
-    let fine = pieces_direct(poly, normal, polygon, light, distant, shadows, depth);
+    let coarse = if depth == 1 { rule.sharp } else { pieces_direct(poly, at, depth - 1) };
+    let fine = pieces_direct(poly, at, depth);
     LeafDirect { direct: std::array::from_fn(|c| fine[c] + rule.soft[c]), error: std::array::from_fn(|c| fine[c] - coarse[c]), soft, edge }
 }
 
 /// The area mean of [`rule_direct`]'s sharp sources over the pieces of `poly` quartered `depth`
 /// times.
-fn pieces_direct(
-    poly: &crate::geom::Poly,
-    normal: DVec3,
-    polygon: u32,
-    light: &DirectLight<'_>,
-    distant: &crate::daylight::DistantLight<'_>,
-    shadows: Option<&ParallelShadows<'_>>,
-    depth: u32,
-) -> [f64; 3] {
+fn pieces_direct(poly: &crate::geom::Poly, at: &LeafSources<'_>, depth: u32) -> [f64; 3] {
     if depth == 0 {
-        return rule_direct(poly, normal, polygon, light, distant, shadows, true, None).sharp;
+        return rule_direct(poly, at, true, None).sharp;
     }
     let (mut sum, mut area) = ([0.0; 3], 0.0);
     for piece in poly.subdivide() {
         let a = piece.area();
-        let d = pieces_direct(&piece, normal, polygon, light, distant, shadows, depth - 1);
+        let d = pieces_direct(&piece, at, depth - 1);
         for c in 0..3 {
             sum[c] += a * d[c];
         }
@@ -68,17 +61,8 @@ fn pieces_direct(
 /// and whether the rule may be inaccurate: a shadow boundary of a luminaire crosses the element
 /// (its points or corners disagree on the luminaire's visibility), or a luminaire that lights it
 /// is nearer than [`MAX_ANGULAR_SIZE`] allows.
-#[expect(clippy::too_many_arguments, reason = "the element, its sources and its quadrature, each read by the rule")]
-fn rule_direct(
-    poly: &crate::geom::Poly,
-    normal: DVec3,
-    polygon: u32,
-    light: &DirectLight<'_>,
-    distant: &crate::daylight::DistantLight<'_>,
-    shadows: Option<&ParallelShadows<'_>>,
-    sharp_only: bool,
-    inherited_soft: Option<[f64; 3]>,
-) -> RuleDirect {
+fn rule_direct(poly: &crate::geom::Poly, at: &LeafSources<'_>, sharp_only: bool, inherited_soft: Option<[f64; 3]>) -> RuleDirect {
+    let LeafSources { normal, polygon, light, distant, shadows } = *at;
     let sources = distant.sources();
     // The sharp distant sources' light comes from their exact lit share where the shadows are
     // known ([`ParallelShadows`]), not from the points.

@@ -3,7 +3,7 @@
 
 use super::ParallelShadows;
 use super::point::DirectLight;
-use super::rule::{LeafDirect, leaf_direct};
+use super::rule::{LeafDirect, LeafSources, leaf_direct};
 use crate::hierarchy::{ElementKind, Hierarchy};
 use crate::light::Lights;
 use crate::visibility::RayCaster;
@@ -39,7 +39,12 @@ pub fn update_direct(h: &mut Hierarchy, lights: &Lights, caster: Option<&RayCast
             match e.kind {
                 ElementKind::Surface { polygon, poly } if e.n_children == 0 => {
                     let inherited = hh.direct_soft.get(e.parent as usize).copied().flatten();
-                    Some(leaf_direct(&poly, e.normal, polygon, &light, &distant, shadows.as_ref(), 1, inherited))
+                    Some(leaf_direct(
+                        &poly,
+                        &LeafSources { normal: e.normal, polygon, light: &light, distant: &distant, shadows: shadows.as_ref() },
+                        1,
+                        inherited,
+                    ))
                 }
                 _ => None,
             }
@@ -78,7 +83,8 @@ pub fn deepen_direct(h: &mut Hierarchy, lights: &Lights, caster: Option<&RayCast
             let ElementKind::Surface { polygon, poly } = e.kind else { return None };
             (e.n_children == 0).then(|| {
                 let own = hh.direct_soft.get(id as usize).copied().flatten();
-                let d = leaf_direct(&poly, e.normal, polygon, &light, &distant, shadows.as_ref(), depth.max(1), own);
+                let at = LeafSources { normal: e.normal, polygon, light: &light, distant: &distant, shadows: shadows.as_ref() };
+                let d = leaf_direct(&poly, &at, depth.max(1), own);
                 (id, d.direct, d.error)
             })
         })
