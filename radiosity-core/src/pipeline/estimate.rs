@@ -29,7 +29,7 @@ impl State {
     /// Pushes the level's polygon means to the history and, under a target error or at the last
     /// level (`last_level`, or refinement refused for memory), estimates the error of `leaf`'s
     /// solution ([`estimate_error`]), each polygon's in `polygon_errors`.
-    pub(super) fn estimate_level(&mut self, cx: &Context<'_>, leaf: &LeafSolved, last_level: bool) -> LevelEstimate {
+    pub(super) fn estimate_level(&mut self, cx: &Context<'_>, leaf: &mut LeafSolved, last_level: bool) -> LevelEstimate {
         let (config, target_error, services) = (cx.config, cx.target_error, cx.services);
         let (h, links, sol) = (&self.h, &self.links, &leaf.solution);
         let t = Instant::now();
@@ -38,7 +38,8 @@ impl State {
         let change = self.history.push(means);
         let last = last_level || self.stats.refused_for_memory > 0;
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
-            .then(|| estimate_error(h, links, sol, services.closed, &leaf.closure_changes, config, leaf.budget));
+            .then(|| estimate_error(h, links, sol, services.closed, &leaf.closure_changes, config, leaf.budget, leaf.coefficients.take()));
+        leaf.coefficients = None;
         let (estimated, irradiance_errors) = match estimated {
             Some((e, per_polygon, irradiance)) => (Some((e, per_polygon)), irradiance),
             None => (None, Vec::new()),
@@ -67,8 +68,11 @@ impl State {
 /// ([`crate::luminaire::direct_polygon_errors`]) is added to the mesh's, polygon by polygon
 /// ([`solve::mesh_and_direct_estimate`]): the largest of each term may lie on different
 /// polygons (on Ward's room at eps 0.64 the estimate fell from 35% to 26% for a true 7.6%).
+/// The coarser solves' coefficients are made from `fine`, the solution's own, where it is given
+/// and they can be ([`solve::LeafCoefficients::coarsened`]), and anew otherwise.
 /// Returns the estimate, each polygon's share in W/m² of radiosity, and under the irradiance
 /// criterion each polygon's mean irradiance's share relative to the largest (empty otherwise).
+#[expect(clippy::too_many_arguments, reason = "the level's solution and what its estimate reads of it")]
 pub(super) fn estimate_error(
     h: &Hierarchy,
     links: &[Link],
@@ -77,6 +81,7 @@ pub(super) fn estimate_error(
     closure_changes: &[f32],
     config: &Config,
     max_bytes: usize,
+    fine: Option<solve::LeafCoefficients>,
 ) -> (f64, Vec<f64>, Vec<f64>) {
     // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
     let irradiance = config.criterion == refine::Criterion::Irradiance;
@@ -89,12 +94,17 @@ pub(super) fn estimate_error(
         results.iter().enumerate().map(|(p, r)| std::array::from_fn(|c| r.h[c] + direct.get(p).map_or(0.0, |d| d[c]))).collect()
     };
     let mut h_means = vec![with_direct(results.clone())];
+    // Each coarser cut's coefficients from the finer cut's where they can be.
+    let mut finer = fine.map(|c| (solve::Cut::leaves(h), c));
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
-        let coefficients =
-            solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error));
+        let coefficients = finer.take().and_then(|(fine_cut, c)| c.coarsened(&fine_cut, &cut, links)).unwrap_or_else(|| {
+            solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error))
+        });
         let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
+        drop(op);
+        finer = (levels < 2).then(|| (solve::Cut::coarsened(h, levels), coefficients));
         let results = crate::solve::polygon_results(h, &coarse);
         means.push(results.iter().map(|r| r.b).collect());
         h_means.push(with_direct(results));

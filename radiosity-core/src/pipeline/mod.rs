@@ -101,11 +101,11 @@ pub fn run_with_points(
         let at = Level { index: level, scale, limits: points.limits(config) };
         // Refine → solve rounds, then the leaf-resolution solve.
         let sol = refine_and_solve(&cx, &mut state, at, &mut points);
-        let leaf = state.leaf_solve(&cx, sol);
-        state.read_level_solution(&cx, level, &leaf.solution);
-        // Estimate, and report the level.
+        let mut leaf = state.leaf_solve(&cx, sol);
+        // Estimate (first, while the leaf coefficients it reuses are held), and report the level.
         let last_level = level - points.rounds + 1 == cx.n_levels;
-        let est = state.estimate_level(&cx, &leaf, last_level);
+        let est = state.estimate_level(&cx, &mut leaf, last_level);
+        state.read_level_solution(&cx, level, &leaf.solution);
         let report = LevelReport {
             balance_gap: est.balance_gap,
             points_error: None,

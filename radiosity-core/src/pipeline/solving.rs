@@ -30,6 +30,10 @@ pub(super) struct LeafSolved {
     /// The budget of the leaf-resolution coefficients, bytes: the estimate's coarser solves keep to
     /// it as well.
     pub(super) budget: usize,
+    /// The leaf-resolution coefficients, kept for the estimate's coarser solves where they can
+    /// be made from them ([`solve::LeafCoefficients::coarsened`]: every unknown's stored, an
+    /// open scene).
+    pub(super) coefficients: Option<solve::LeafCoefficients>,
 }
 
 impl State {
@@ -89,10 +93,10 @@ impl State {
         self.leaf_entries = leaf.as_ref().map_or(0, solve::LeafCoefficients::entries);
         // The closure's changes outlive the coefficients, for the estimate.
         let closure_changes = leaf.as_ref().map_or_else(Vec::new, |c| c.closure_changes().to_vec());
-        drop(leaf);
+        let coefficients = leaf.filter(|c| config.estimate_error && !cx.services.closed && c.is_complete());
         self.iterations += more_iterations;
         self.timings.solve += t.elapsed().as_secs_f64();
-        LeafSolved { solution: sol, closure_changes, budget: leaf_budget }
+        LeafSolved { solution: sol, closure_changes, budget: leaf_budget, coefficients }
     }
 
     /// What the next level's refinement reads of the level's solution `sol` ([`update_data`]),

@@ -114,14 +114,7 @@ impl Chain<'_> {
     /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets
     /// relative to `coef`, length `unknowns.len() + 1`), each as `store` turns it, in parallel.
     pub(super) fn fill<T: Send>(&self, unknowns: &[ElementId], start: &[usize], coef: &mut [T], store: impl Fn(f32) -> T + Sync) {
-        let mut slices: Vec<&mut [T]> = Vec::with_capacity(unknowns.len());
-        let mut rest = coef;
-        for w in start.windows(2) {
-            let (a, b) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
-            slices.push(a);
-            rest = b;
-        }
-        slices.into_par_iter().zip(unknowns.par_iter()).with_min_len(16).for_each(|(out, &u)| {
+        fill_each(unknowns, start, coef, |u, out| {
             let mut j = 0;
             self.for_each_raw(u, |_, c| {
                 out[j] = store(c);
@@ -129,4 +122,17 @@ impl Chain<'_> {
             });
         });
     }
+}
+
+/// Calls `f(unknown, its slice of coef)` for every one of `unknowns` (in order, `start` their
+/// offsets relative to `coef`, length `unknowns.len() + 1`), in parallel.
+pub(super) fn fill_each<T: Send>(unknowns: &[ElementId], start: &[usize], coef: &mut [T], f: impl Fn(ElementId, &mut [T]) + Sync) {
+    let mut slices: Vec<&mut [T]> = Vec::with_capacity(unknowns.len());
+    let mut rest = coef;
+    for w in start.windows(2) {
+        let (a, b) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+        slices.push(a);
+        rest = b;
+    }
+    slices.into_par_iter().zip(unknowns.par_iter()).with_min_len(16).for_each(|(out, &u)| f(u, out));
 }

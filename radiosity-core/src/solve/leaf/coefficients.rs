@@ -3,7 +3,7 @@
 //! each link's transfer, the source side's weights, the closure of a closed scene, and the value
 //! each link sends. The contract they keep is in the folder's `mod.rs`.
 
-use super::chain::{Chain, LeavesBelow};
+use super::chain::{Chain, LeavesBelow, fill_each};
 use super::precision::{Precision, Stored, encode};
 use super::weights::{SourceWeights, own_weights, source_weights};
 use super::{CLOSURE_MAX, CLOSURE_MIN, CLOSURE_NOISE_MAX, LeafCoefficients, STREAM_BATCH_ENTRIES, SourceValue, WEIGHT_CHUNK};
@@ -60,49 +60,14 @@ impl LeafCoefficients {
                 Stored::Half(v)
             }
         };
-        // Links received inside an unknown: their transfer, spread over its area.
-        let inside_lists: Vec<Vec<(u32, f64)>> = unknowns
-            .par_iter()
-            .map(|&u| {
-                let area = h.get(u).area;
-                let mut list = Vec::new();
-                let mut stack: Vec<ElementId> = h.children_of(u).to_vec();
-                while let Some(d) = stack.pop() {
-                    let (lo, hi) = range[d as usize];
-                    for &k in &sorted[lo as usize..hi as usize] {
-                        let l = &links[k as usize];
-                        let c = h.get(d).area / area * l.ff * l.vis;
-                        if c > 0.0 {
-                            list.push((k, c));
-                        }
-                    }
-                    stack.extend_from_slice(h.children_of(d));
-                }
-                list
-            })
-            .collect();
-        let mut inside_start = Vec::with_capacity(unknowns.len() + 1);
-        inside_start.push(0u32);
-        let mut inside = Vec::new();
-        for list in inside_lists {
-            inside.extend(list);
-            inside_start.push(inside.len() as u32);
-        }
+        let (inside_start, inside) = inside_links(h, unknowns, &sorted, &range, links);
         // The receiver side's total per link, `Σ_unknowns A F V`, summed in cut order (unstored
         // unknowns' coefficients computed a batch at a time).
         let mut receiver_total = vec![0.0; links.len()];
         // Adds unknown `i`'s `A F V` to its links' totals, its `j`th chain coefficient `coef(j)`.
         let mut add_unknown = |i: usize, coef: &dyn Fn(usize) -> f32| {
-            let u = unknowns[i];
-            let area = h.get(u).area;
-            let mut j = 0;
-            chain.for_each_link(u, |k| {
-                receiver_total[k as usize] += area * f64::from(coef(j));
-                j += 1;
-            });
-            for &(k, c) in &inside[inside_start[i] as usize..inside_start[i + 1] as usize] {
-                receiver_total[k as usize] += area * c;
-            }
+            let inside = &inside[inside_start[i] as usize..inside_start[i + 1] as usize];
+            add_receiver_totals(&mut receiver_total, &chain, unknowns[i], inside, coef);
         };
         for (i, w) in start.windows(2).enumerate() {
             add_unknown(i, &|j| coef.get(w[0] + j));
@@ -205,17 +170,191 @@ impl LeafCoefficients {
             inside_start,
             inside,
             scale,
+            transfer,
             value,
             weight_leaf,
             weight,
             shared,
+            closed,
             closure: (1.0, 1.0),
             closure_change: Vec::new(),
         };
         if closed {
+            let transfer = std::mem::take(&mut c.transfer);
             c.close(cut, &transfer);
+            c.transfer = transfer;
         }
         c
+    }
+
+    /// The coefficients of the same links on `coarse`, a cut whose every unknown lies at or above
+    /// unknowns of `fine` (a [`Cut::coarsened`] further than `fine`), made from `self`, built for
+    /// `fine`, without evaluating a form factor again. Both sides are additive over the area of
+    /// an unknown: a coarse unknown `u`'s coefficient on a link of its chain is the area-weighted
+    /// mean `Σ_c A_c F(c ← S) V / Σ_c A_c` of the finer unknowns `c` below it on the same link
+    /// (whose chains end with `u`'s), and a source's weight on `u` is the sum of its weights on
+    /// those `c`; each link carries the transfer it carries on `fine`. The coarse cut then differs
+    /// from the fine one by its unknowns alone, not by the quadrature of its form factors. Links
+    /// received below a coarse unknown spread their transfer over it as in
+    /// [`LeafCoefficients::for_cut`].
+    ///
+    /// `None` where `self` does not hold every unknown's chain coefficients, or in a closed scene
+    /// (the closure has rescaled its weights to `fine`'s unknowns): there
+    /// [`LeafCoefficients::for_cut`] builds them anew.
+    #[must_use]
+    pub fn coarsened(self, fine: &Cut<'_>, coarse: &Cut<'_>, links: &[Link]) -> Option<LeafCoefficients> {
+        if self.closed || !self.is_complete() || self.scale.len() != links.len() {
+            return None;
+        }
+        let h = coarse.hierarchy();
+        let precision = self.precision();
+        let chain = Chain { h, links, sorted: &self.sorted, range: &self.range, precision };
+        let unknowns = coarse.elements();
+        let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
+        let mut start = Vec::with_capacity(unknowns.len() + 1);
+        start.push(0);
+        for &len in &lens {
+            start.push(start[start.len() - 1] + len);
+        }
+        let chain_entries = start[start.len() - 1];
+        // Every finer unknown below a coarse one, with the offset of the coarse chain in its own.
+        let fine_below = LeavesBelow::new(fine);
+        let mut below_ok = true;
+        for (i, &u) in unknowns.iter().enumerate() {
+            for &c in fine_below.below(u) {
+                let f = fine.unknown_of(c)?;
+                below_ok &= self.start[f + 1] - self.start[f] >= lens[i];
+            }
+            below_ok &= !fine_below.below(u).is_empty();
+        }
+        if !below_ok {
+            return None;
+        }
+        let mean = |u: ElementId, out: &mut [f64]| {
+            let n = out.len();
+            let mut area = 0.0;
+            for &c in fine_below.below(u) {
+                let f = fine.unknown_of(c).expect("checked above");
+                let (a, b) = (self.start[f], self.start[f + 1]);
+                let from = a + (b - a - n);
+                let w = h.get(c).area;
+                for (j, o) in out.iter_mut().enumerate() {
+                    *o += w * f64::from(self.coef.get(from + j));
+                }
+                area += w;
+            }
+            let inv = if area > 0.0 { 1.0 / area } else { 0.0 };
+            out.iter_mut().for_each(|o| *o *= inv);
+        };
+        let fill = |u: ElementId, n: usize, store: &mut dyn FnMut(usize, f32)| {
+            let mut acc = vec![0.0; n];
+            mean(u, &mut acc);
+            for (j, &x) in acc.iter().enumerate() {
+                store(j, x as f32);
+            }
+        };
+        let coef = match precision {
+            Precision::Single => {
+                let mut v = vec![0.0f32; chain_entries];
+                fill_each(unknowns, &start, &mut v, |u, out| {
+                    let n = out.len();
+                    fill(u, n, &mut |j, x| out[j] = x);
+                });
+                Stored::Single(v)
+            }
+            Precision::Half => {
+                let mut v = vec![0u16; chain_entries];
+                fill_each(unknowns, &start, &mut v, |u, out| {
+                    let n = out.len();
+                    fill(u, n, &mut |j, x| out[j] = encode(x));
+                });
+                Stored::Half(v)
+            }
+        };
+        // The finer chains are done with.
+        let mut this = self;
+        this.coef = Stored::Single(Vec::new());
+        this.start = Vec::new();
+        let this = this;
+        let chain = Chain { h, links, sorted: &this.sorted, range: &this.range, precision };
+        let (inside_start, inside) = inside_links(h, unknowns, &this.sorted, &this.range, links);
+        let mut receiver_total = vec![0.0; links.len()];
+        for (i, w) in start.windows(2).enumerate() {
+            let inside = &inside[inside_start[i] as usize..inside_start[i + 1] as usize];
+            add_receiver_totals(&mut receiver_total, &chain, unknowns[i], inside, &|j| coef.get(w[0] + j));
+        }
+        // Source side: each weight range summed over the coarse unknowns its leaves lie in.
+        let coarse_below = LeavesBelow::new(coarse);
+        let mut value = vec![SourceValue::Leaf(NONE); links.len()];
+        let (mut weight_leaf, mut weight, mut shared) = (Vec::new(), Vec::new(), Vec::new());
+        let mut leaves_of: std::collections::HashMap<usize, u32> = std::collections::HashMap::new();
+        let mut shared_of: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+        // Appends the coarse weights of the range `lo..hi` (fine leaves from `leaves`) of source
+        // `s`; returns the start of its coarse leaves in `weight_leaf`.
+        let mut aggregate = |s: ElementId, lo: usize, hi: usize, leaves: usize, weight: &mut Vec<f64>| -> Option<u32> {
+            let list = coarse_below.below(s);
+            let at = *leaves_of.entry(leaves).or_insert_with(|| {
+                weight_leaf.extend_from_slice(list);
+                (weight_leaf.len() - list.len()) as u32
+            });
+            let begin = weight.len();
+            weight.resize(begin + list.len(), 0.0);
+            let mut p = 0;
+            for (&y, &w) in this.weighted_leaves(lo, hi, leaves) {
+                let u = unknowns[coarse.unknown_of(y)?];
+                while list.get(p).is_some_and(|&x| x != u) {
+                    p += 1;
+                }
+                *weight.get_mut(begin + p)? += w;
+            }
+            Some(at)
+        };
+        for (k, l) in links.iter().enumerate() {
+            if let Some(i) = coarse.unknown_of(l.source) {
+                value[k] = SourceValue::Leaf(unknowns[i]);
+                continue;
+            }
+            value[k] = match this.value[k] {
+                SourceValue::Leaf(e) => SourceValue::Leaf(e),
+                SourceValue::Own(lo, hi, leaves) => {
+                    let begin = weight.len() as u32;
+                    let at = aggregate(l.source, lo as usize, hi as usize, leaves as usize, &mut weight)?;
+                    SourceValue::Own(begin, weight.len() as u32, at)
+                }
+                SourceValue::Shared(i) => {
+                    if let Some(&j) = shared_of.get(&i) {
+                        SourceValue::Shared(j)
+                    } else {
+                        let (s, lo, hi, leaves) = this.shared[i as usize];
+                        let begin = weight.len();
+                        let at = aggregate(s, lo, hi, leaves, &mut weight)?;
+                        shared.push((s, begin, weight.len(), at as usize));
+                        shared_of.insert(i, (shared.len() - 1) as u32);
+                        SourceValue::Shared((shared.len() - 1) as u32)
+                    }
+                }
+            };
+        }
+        let LeafCoefficients { sorted, range, transfer, .. } = this;
+        let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
+        Some(LeafCoefficients {
+            sorted,
+            range,
+            start,
+            coef,
+            chain_entries,
+            inside_start,
+            inside,
+            scale,
+            transfer,
+            value,
+            weight_leaf,
+            weight,
+            shared,
+            closed: false,
+            closure: (1.0, 1.0),
+            closure_change: Vec::new(),
+        })
     }
 
     /// The smallest and largest factor the closure applied to a source unknown's delivered light
@@ -359,6 +498,7 @@ impl LeafCoefficients {
             + self.inside_start.len() * size_of::<u32>()
             + self.inside.len() * size_of::<(u32, f64)>()
             + self.scale.len() * size_of::<f64>()
+            + self.transfer.len() * size_of::<f64>()
             + self.value.len() * size_of::<SourceValue>()
             + self.weight_leaf.len() * size_of::<ElementId>()
             + self.weight.len() * size_of::<f64>()
@@ -397,5 +537,58 @@ impl LeafCoefficients {
                 x.map(|x| x * s)
             })
             .collect()
+    }
+}
+
+/// The links received inside each of `unknowns` (below it), each with its transfer spread over the
+/// unknown's area: `(start per unknown, (link, coefficient))`.
+fn inside_links(
+    h: &Hierarchy,
+    unknowns: &[ElementId],
+    sorted: &[u32],
+    range: &[(u32, u32)],
+    links: &[Link],
+) -> (Vec<u32>, Vec<(u32, f64)>) {
+    let inside_lists: Vec<Vec<(u32, f64)>> = unknowns
+        .par_iter()
+        .map(|&u| {
+            let area = h.get(u).area;
+            let mut list = Vec::new();
+            let mut stack: Vec<ElementId> = h.children_of(u).to_vec();
+            while let Some(d) = stack.pop() {
+                let (lo, hi) = range[d as usize];
+                for &k in &sorted[lo as usize..hi as usize] {
+                    let l = &links[k as usize];
+                    let c = h.get(d).area / area * l.ff * l.vis;
+                    if c > 0.0 {
+                        list.push((k, c));
+                    }
+                }
+                stack.extend_from_slice(h.children_of(d));
+            }
+            list
+        })
+        .collect();
+    let mut inside_start = Vec::with_capacity(unknowns.len() + 1);
+    inside_start.push(0u32);
+    let mut inside = Vec::new();
+    for list in inside_lists {
+        inside.extend(list);
+        inside_start.push(inside.len() as u32);
+    }
+    (inside_start, inside)
+}
+
+/// Adds unknown `u`'s `A F V` to its links' totals in `totals`: its `j`th chain coefficient
+/// `coef(j)`, and `inside`, the links received below it.
+fn add_receiver_totals(totals: &mut [f64], chain: &Chain<'_>, u: ElementId, inside: &[(u32, f64)], coef: &dyn Fn(usize) -> f32) {
+    let area = chain.h.get(u).area;
+    let mut j = 0;
+    chain.for_each_link(u, |k| {
+        totals[k as usize] += area * f64::from(coef(j));
+        j += 1;
+    });
+    for &(k, c) in inside {
+        totals[k as usize] += area * c;
     }
 }

@@ -94,6 +94,8 @@ pub struct LeafCoefficients {
     /// Per link: the factor on its receiver-side coefficients that makes them carry the link's
     /// transfer (and, in a closed scene, the closure factor of its source).
     scale: Vec<f64>,
+    /// Per link, the transfer `τ_L` both sides are scaled to (before a closure).
+    transfer: Vec<f64>,
     /// Per link, where its source value comes from.
     value: Vec<SourceValue>,
     /// The leaves below each source with weights, once per source (every range of weights of a
@@ -105,6 +107,8 @@ pub struct LeafCoefficients {
     /// Sources with shared weights: `(source, start, end, leaves)` into `weight`, and the start
     /// of its leaves in `weight_leaf`.
     shared: Vec<(ElementId, usize, usize, usize)>,
+    /// Built for a closed scene (with the closure applied).
+    closed: bool,
     /// Smallest and largest closure factor applied ([`LeafCoefficients::closure`]).
     closure: (f64, f64),
     /// Per link, the closure factor on its transfer less 1 (empty in an open scene).
