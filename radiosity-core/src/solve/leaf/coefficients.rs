@@ -147,12 +147,12 @@ impl LeafCoefficients {
                 weight_leaf.extend_from_slice(below.below(s));
                 for (k, w) in r.own {
                     let begin = weight.len() as u32;
-                    weight.extend(w);
+                    weight.extend(w.iter().map(|&x| x as f32));
                     value[k as usize] = SourceValue::Own(begin, weight.len() as u32, leaves as u32);
                 }
                 if let Some(w) = r.shared {
                     let begin = weight.len();
-                    weight.extend(w);
+                    weight.extend(w.iter().map(|&x| x as f32));
                     for &k in r.far.iter() {
                         value[k as usize] = SourceValue::Shared(shared.len() as u32);
                     }
@@ -291,22 +291,24 @@ impl LeafCoefficients {
         let mut shared_of: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
         // Appends the coarse weights of the range `lo..hi` (fine leaves from `leaves`) of source
         // `s`; returns the start of its coarse leaves in `weight_leaf`.
-        let mut aggregate = |s: ElementId, lo: usize, hi: usize, leaves: usize, weight: &mut Vec<f64>| -> Option<u32> {
+        let mut sums = Vec::new();
+        let mut aggregate = |s: ElementId, lo: usize, hi: usize, leaves: usize, weight: &mut Vec<f32>| -> Option<u32> {
             let list = coarse_below.below(s);
             let at = *leaves_of.entry(leaves).or_insert_with(|| {
                 weight_leaf.extend_from_slice(list);
                 (weight_leaf.len() - list.len()) as u32
             });
-            let begin = weight.len();
-            weight.resize(begin + list.len(), 0.0);
+            sums.clear();
+            sums.resize(list.len(), 0.0);
             let mut p = 0;
             for (&y, &w) in this.weighted_leaves(lo, hi, leaves) {
                 let u = unknowns[coarse.unknown_of(y)?];
                 while list.get(p).is_some_and(|&x| x != u) {
                     p += 1;
                 }
-                *weight.get_mut(begin + p)? += w;
+                *sums.get_mut(p)? += f64::from(w);
             }
+            weight.extend(sums.iter().map(|&x| x as f32));
             Some(at)
         };
         for (k, l) in links.iter().enumerate() {
@@ -402,7 +404,7 @@ impl LeafCoefficients {
                 }
             };
             for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
-                add(y, transfer[k] * q);
+                add(y, transfer[k] * f64::from(q));
             }
         }
         let factor: Vec<f64> = delivered.iter().map(|&d| if d > 0.0 { (1.0 / d).clamp(CLOSURE_MIN, CLOSURE_MAX) } else { 1.0 }).collect();
@@ -410,13 +412,12 @@ impl LeafCoefficients {
         // Rescale the weights of each range by the factors, renormalise, and keep each range's
         // mean factor: a link's transfer scales by its range's mean factor.
         let mut rescale = |lo: usize, hi: usize, leaves: usize| -> f64 {
-            let mut sum = 0.0;
-            for (&y, w) in self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&mut self.weight[lo..hi]) {
-                *w *= f(y);
-                sum += *w;
-            }
-            if sum > 0.0 {
-                self.weight[lo..hi].iter_mut().for_each(|w| *w /= sum);
+            let scaled: Vec<f64> =
+                self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]).map(|(&y, &w)| f64::from(w) * f(y)).collect();
+            let sum: f64 = scaled.iter().sum();
+            let norm = if sum > 0.0 { sum } else { 1.0 };
+            for (w, x) in self.weight[lo..hi].iter_mut().zip(&scaled) {
+                *w = (x / norm) as f32;
             }
             sum
         };
@@ -501,13 +502,13 @@ impl LeafCoefficients {
             + self.transfer.len() * size_of::<f64>()
             + self.value.len() * size_of::<SourceValue>()
             + self.weight_leaf.len() * size_of::<ElementId>()
-            + self.weight.len() * size_of::<f64>()
+            + self.weight.len() * size_of::<f32>()
             + self.shared.len() * size_of::<(ElementId, usize, usize, usize)>()
     }
 
     /// The leaves and weights of the range `lo..hi` of `weight`, whose source's leaves start at
     /// `leaves` in `weight_leaf`.
-    fn weighted_leaves(&self, lo: usize, hi: usize, leaves: usize) -> impl Iterator<Item = (&ElementId, &f64)> {
+    fn weighted_leaves(&self, lo: usize, hi: usize, leaves: usize) -> impl Iterator<Item = (&ElementId, &f32)> {
         self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi])
     }
 
@@ -517,7 +518,7 @@ impl LeafCoefficients {
         let weighted = |lo: usize, hi: usize, leaves: usize| {
             let mut acc = [0.0; 3];
             for (&y, &w) in self.weighted_leaves(lo, hi, leaves) {
-                let by = b[y as usize];
+                let (by, w) = (b[y as usize], f64::from(w));
                 for c in 0..3 {
                     acc[c] += w * by[c];
                 }
