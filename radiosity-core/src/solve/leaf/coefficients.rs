@@ -6,7 +6,9 @@
 use super::chain::{Chain, LeavesBelow, fill_each};
 use super::precision::{Precision, Stored, encode};
 use super::weights::{SourceWeights, own_weights, source_weights};
-use super::{CLOSURE_MAX, CLOSURE_MIN, CLOSURE_NOISE_MAX, LeafCoefficients, STREAM_BATCH_ENTRIES, SourceValue, WEIGHT_CHUNK};
+use super::{
+    CLOSURE_MAX, CLOSURE_MIN, CLOSURE_NOISE_MAX, LeafCoefficients, STREAM_BATCH_ENTRIES, SourceValue, WEIGHT_CHUNK, WEIGHT_CHUNK_ENTRIES,
+};
 use crate::hierarchy::{ElementId, Hierarchy, NONE};
 use crate::refine::Link;
 use crate::solve::by_receiver::LinksByReceiver;
@@ -124,16 +126,30 @@ impl LeafCoefficients {
         // made all at once, then copied into vectors grown by doubling, they held up to three
         // times their size (573 MB of a 1.01 GB heap peak on a 3,200-leaf canopy).
         let (mut n_leaves, mut n_weights) = (0, 0);
-        for group in &groups {
+        // A chunk holds at most WEIGHT_CHUNK sources and WEIGHT_CHUNK_ENTRIES weights, or one source.
+        let mut chunk_ends = Vec::new();
+        let (mut in_chunk, mut chunk_sources) = (0, 0);
+        for (i, group) in groups.iter().enumerate() {
             let s = links[group[0] as usize].source;
             let n = below.below(s).len();
             let own = group.iter().filter(|&&k| own_weights(h, &below, &links[k as usize])).count();
+            let entries = n * (own + usize::from(own < group.len()));
+            if chunk_sources > 0 && (chunk_sources == WEIGHT_CHUNK || in_chunk + entries > WEIGHT_CHUNK_ENTRIES) {
+                chunk_ends.push(i);
+                (in_chunk, chunk_sources) = (0, 0);
+            }
+            in_chunk += entries;
+            chunk_sources += 1;
             n_leaves += n;
-            n_weights += n * (own + usize::from(own < group.len()));
+            n_weights += entries;
         }
+        chunk_ends.push(groups.len());
         let (mut weight_leaf, mut weight) = (Vec::with_capacity(n_leaves), Vec::with_capacity(n_weights));
         let mut shared = Vec::new();
-        for chunk in groups.chunks(WEIGHT_CHUNK) {
+        let mut chunk_start = 0;
+        for &chunk_end in &chunk_ends {
+            let chunk = &groups[chunk_start..chunk_end];
+            chunk_start = chunk_end;
             let results: Vec<SourceWeights> = chunk.par_iter().map(|group| source_weights(h, links, &below, group, &transfer)).collect();
             for (group, r) in chunk.iter().zip(results) {
                 let s = links[group[0] as usize].source;
