@@ -188,7 +188,7 @@ fn four_bands_are_two_solves_that_agree_with_one() {
 #[test]
 fn bad_daylight_input_is_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &str); 10] = [
+    let cases: [(&str, &str); 14] = [
         (
             "bands = [\"PAR\", \"NIR\"]\n[[material]]\nname = \"m\"\nreflectance = [0.1, 0.2, 0.3]\n",
             "3 values given, the scene has 2 bands",
@@ -208,6 +208,16 @@ fn bad_daylight_input_is_one_clear_line() {
             "type 16: give 1 to 15",
         ),
         ("[sky]\nmodel = \"uniform\"\ntype = 3\ndiffuse_horizontal = 100\n", "`type` applies to model = \"cie-general\" only"),
+        ("[sky]\nmodel = \"perez\"\nclearness = 3\nbrightness = 0.2\ndiffuse_horizontal = 100\n", "needs the sun's position"),
+        (
+            "[sun]\ndirection = [0, 0.5, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"perez\"\nclearness = 3\ndiffuse_horizontal = 100\n",
+            "needs `clearness` and `brightness`",
+        ),
+        (
+            "[sun]\ndirection = [0, 0.5, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"perez\"\nclearness = 0.5\nbrightness = 0.2\ndiffuse_horizontal = 100\n",
+            "clearness 0.5 outside the model's range",
+        ),
+        ("[sky]\nmodel = \"uniform\"\nbrightness = 0.2\ndiffuse_horizontal = 100\n", "apply to model = \"perez\" only"),
     ];
     for (i, (text, expected)) in cases.iter().enumerate() {
         let name = format!("bad{i}.toml");
@@ -228,6 +238,19 @@ fn a_cie_general_sky_lights_an_open_ground_exactly() {
     let dir = tempfile::tempdir().unwrap();
     let sky =
         "[sun]\ndirection = [0.0, 0.6, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"cie-general\"\ntype = 12\ndiffuse_horizontal = 100\n";
+    let s = solve(dir.path(), &format!("{GROUND}{sky}"));
+    assert!((s["power_incident"].as_f64().unwrap() - 10_000.0).abs() < EXACT_TOL * 10_000.0, "{}", s["power_incident"]);
+    let (header, rows) = csv(&dir.path().join("out/patches.csv"));
+    let h = rows[0][column(&header, "h_g")].parse::<f64>().unwrap();
+    assert!((h - 100.0).abs() < EXACT_TOL * 100.0, "irradiance {h}");
+}
+
+/// A Perez sky from the scene file (clearness 3.2, brightness 0.25, its sun given by `[sun]` with
+/// no beam): an open ground receives the diffuse horizontal irradiance exactly.
+#[test]
+fn a_perez_sky_lights_an_open_ground_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let sky = "[sun]\ndirection = [0.0, 0.6, -0.8]\ndirect_normal = 0\n[sky]\nmodel = \"perez\"\nclearness = 3.2\nbrightness = 0.25\ndiffuse_horizontal = 100\n";
     let s = solve(dir.path(), &format!("{GROUND}{sky}"));
     assert!((s["power_incident"].as_f64().unwrap() - 10_000.0).abs() < EXACT_TOL * 10_000.0, "{}", s["power_incident"]);
     let (header, rows) = csv(&dir.path().join("out/patches.csv"));

@@ -7,10 +7,11 @@
 //! ([`CIE_GENERAL_TYPES`]): types 1–5 overcast (5: uniform luminance), 6–10 intermediate, 11–15
 //! clear (12: the CIE standard clear sky).
 //!
-//! A sky cell's light vector `∫ L ω dω` is a Gauss–Legendre quadrature over the cell in zenith
-//! angle and azimuth (8 × 8 nodes; smooth integrands: the gradation has
-//! every derivative zero at the horizon, the indicatrix is smooth through the sun).
+//! A sky cell's light vector `∫ L ω dω` is a Gauss–Legendre quadrature over the cell
+//! (`quadrature.rs`; smooth integrands: the gradation has every derivative zero at the horizon,
+//! the indicatrix is smooth through the sun).
 
+use super::quadrature::{light_vector, scaled_sources};
 use super::{DaylightError, DistantSource, Site, SkyCell};
 
 /// A CIE general sky: its type (1–15) and the sun's position in the site's frame (radians;
@@ -35,14 +36,6 @@ const INDICATRIX: [(f64, f64, f64); 6] =
 /// The 15 types: `(gradation group, indicatrix group)`, 1-based as the standard numbers them.
 pub const CIE_GENERAL_TYPES: [(u8, u8); 15] =
     [(1, 1), (1, 2), (2, 1), (2, 2), (3, 1), (3, 2), (3, 3), (3, 4), (4, 2), (4, 3), (4, 4), (5, 4), (5, 5), (6, 5), (6, 6)];
-
-/// 8-point Gauss–Legendre nodes and weights on `[−1, 1]` (positive half; the rule is symmetric).
-const GL8: [(f64, f64); 4] = [
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
-    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
-    (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
-    (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
-];
 
 impl CieSky {
     /// A sky of type `sky_type` with the sun at `sun_zenith`, `sun_azimuth` (radians).
@@ -79,42 +72,11 @@ impl CieSky {
         gradation(zenith) * indicatrix(chi) / (gradation(0.0) * indicatrix(zs))
     }
 
-    /// The light vector `∫ L ω dω / L_z` of `cell` in the site's frame (x east, y north, z up).
-    fn light_vector(self, cell: &SkyCell) -> [f64; 3] {
-        let (t0, t1) = (cell.mu_high.clamp(-1.0, 1.0).acos(), cell.mu_low.clamp(-1.0, 1.0).acos());
-        let (tm, th) = (0.5 * (t0 + t1), 0.5 * (t1 - t0));
-        let (pm, ph) = (cell.phi_start + 0.5 * cell.phi_width, 0.5 * cell.phi_width);
-        let nodes = GL8.iter().flat_map(|&(x, w)| [(-x, w), (x, w)]);
-        let mut v = [0.0; 3];
-        for (x, wx) in nodes.clone() {
-            let theta = tm + th * x;
-            let (st, ct) = theta.sin_cos();
-            for (y, wy) in nodes.clone() {
-                let phi = pm + ph * y;
-                let (sp, cp) = phi.sin_cos();
-                let w = wx * wy * th * ph * st * self.relative_luminance(theta, phi);
-                v[0] += w * st * sp;
-                v[1] += w * st * cp;
-                v[2] += w * ct;
-            }
-        }
-        v
-    }
-
     /// The sky as one distant source per cell, delivering `diffuse_horizontal` to an
     /// unobstructed horizontal plane (see [`super::sky`]).
     pub(super) fn sources(self, cells: &[SkyCell], diffuse_horizontal: [f64; 3], site: &Site) -> Vec<DistantSource> {
-        let vectors: Vec<[f64; 3]> = cells.iter().map(|c| self.light_vector(c)).collect();
-        let total: f64 = vectors.iter().map(|v| v[2]).sum();
-        vectors
-            .iter()
-            .map(|v| {
-                let magnitude = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                let zenith = v[0].hypot(v[1]).atan2(v[2]);
-                let azimuth = v[0].atan2(v[1]);
-                let scale = magnitude / total;
-                DistantSource { toward: -site.direction(zenith, azimuth), irradiance: diffuse_horizontal.map(|e| e * scale), sharp: false }
-            })
-            .collect()
+        let vectors: Vec<[f64; 3]> =
+            cells.iter().map(|c| light_vector(c, |zenith, azimuth| self.relative_luminance(zenith, azimuth))).collect();
+        scaled_sources(&vectors, diffuse_horizontal, site)
     }
 }

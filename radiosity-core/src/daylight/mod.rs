@@ -7,8 +7,9 @@
 //! upper hemisphere split into cells of equal solid angle ([`sky_cells`]: 46 or 145 cells, like
 //! the "turtle" skies canopy models use, or any count from 1 up), each cell one source: its light
 //! vector `∫ L ω dω` under the chosen radiance distribution ([`SkyModel`]: uniform, the CIE
-//! standard overcast sky `L(θ) ∝ (1 + 2 cos θ) / 3`, or one of the 15 CIE standard general skies
-//! with the sun's position, [`CieSky`]), scaled so that the sky delivers the given
+//! standard overcast sky `L(θ) ∝ (1 + 2 cos θ) / 3`, one of the 15 CIE standard general skies
+//! with the sun's position, [`CieSky`], or the Perez all-weather sky of a clearness and a
+//! brightness, [`PerezSky`]), scaled so that the sky delivers the given
 //! diffuse horizontal irradiance. A plane that sees a whole cell gets exactly that cell's light, so
 //! the discretised sky gives an unobstructed horizontal plane the diffuse horizontal irradiance
 //! exactly, whatever the cell count, and a vertical one within 1% (145 cells: 0.5% uniform, 0.6% overcast).
@@ -23,7 +24,8 @@
 //!
 //! One file per step: where the sun is and the site's frame (`sun.rs`); the sky models, their
 //! cells and the hemisphere of cells the escaped light is looked for through (`sky.rs`); the CIE
-//! general skies' luminance and their cells' light vectors (`cie_general.rs`);
+//! general skies' luminance (`cie_general.rs`) and the Perez sky's (`perez.rs`), and the light
+//! vectors of cells under either (`quadrature.rs`);
 //! [`DistantLight`], the distant sources seen from a point with a shadow ray (`distant.rs`); which
 //! one-sided faces get a back and which backs are open (`backs.rs`); the power that arrives, leaves
 //! the scene or is lost at open backs, and the balance of a solve (`balance.rs`).
@@ -32,6 +34,8 @@ mod backs;
 mod balance;
 mod cie_general;
 mod distant;
+mod perez;
+mod quadrature;
 mod sky;
 mod sun;
 
@@ -42,6 +46,10 @@ pub use backs::{open_backs, two_sided_where_backs_see_light};
 pub use balance::{Leaving, OutsideLinks, balance_gap, outside_links, power_incident, power_incident_on_backs, power_leaving};
 pub use cie_general::{CIE_GENERAL_TYPES, CieSky};
 pub use distant::{DistantLight, FAR_REL};
+pub use perez::{
+    PEREZ_BRIGHTNESS_RANGE, PEREZ_CLEARNESS_BINS, PEREZ_CLEARNESS_RANGE, PEREZ_MIN_BRIGHTNESS_MID_BINS, PerezSky, SOLAR_CONSTANT,
+    perez_parameters,
+};
 pub use sky::{ESCAPE_CELLS, RINGS_46, RINGS_145, SkyCell, SkyModel, escape_cells, sky, sky_cells};
 pub use sun::{Site, SunReport, sun, sun_position};
 

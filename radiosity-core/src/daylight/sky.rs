@@ -2,6 +2,7 @@
 //! the same cells as the hemisphere through which the light leaving a surface is followed.
 
 use super::cie_general::CieSky;
+use super::perez::PerezSky;
 use super::{DaylightError, DistantSource, Site, check_levels};
 use crate::geom::DVec3;
 
@@ -15,6 +16,8 @@ pub enum SkyModel {
     CieOvercast,
     /// One of the 15 CIE standard general skies, with the sun's position ([`CieSky`]).
     CieGeneral(CieSky),
+    /// The Perez all-weather sky, with the sun's position ([`PerezSky`]).
+    Perez(PerezSky),
 }
 
 impl SkyModel {
@@ -28,7 +31,7 @@ impl SkyModel {
             (SkyModel::Uniform, _) => half_disc,
             (SkyModel::CieOvercast, 1) => (mu * mu / 2.0 + 2.0 * mu.powi(3) / 3.0) / 3.0,
             (SkyModel::CieOvercast, _) => (half_disc + 2.0 * (1.0 - root.powi(3)) / 3.0) / 3.0,
-            (SkyModel::CieGeneral(_), _) => unreachable!("a CIE general sky's cells are integrated numerically"),
+            (SkyModel::CieGeneral(_) | SkyModel::Perez(_), _) => unreachable!("these skies' cells are integrated numerically"),
         }
     }
 }
@@ -93,12 +96,15 @@ pub fn sky_cells(n: u32) -> Result<Vec<SkyCell>, DaylightError> {
 
 /// The sky as `n` distant sources (see [`sky_cells`]) under `model`, delivering
 /// `diffuse_horizontal` (W/m² per channel) to an unobstructed horizontal plane: each cell's light
-/// vector in closed form for the uniform and overcast skies, by quadrature for a CIE general sky.
+/// vector in closed form for the uniform and overcast skies, by quadrature for a CIE general or
+/// a Perez sky.
 pub fn sky(model: SkyModel, diffuse_horizontal: [f64; 3], n: u32, site: &Site) -> Result<Vec<DistantSource>, DaylightError> {
     check_levels("diffuse_horizontal", &diffuse_horizontal)?;
     let cells = sky_cells(n)?;
-    if let SkyModel::CieGeneral(general) = model {
-        return Ok(general.sources(&cells, diffuse_horizontal, site));
+    match model {
+        SkyModel::CieGeneral(general) => return Ok(general.sources(&cells, diffuse_horizontal, site)),
+        SkyModel::Perez(perez) => return Ok(perez.sources(&cells, diffuse_horizontal, site)),
+        SkyModel::Uniform | SkyModel::CieOvercast => {}
     }
     let weights: Vec<f64> = cells.iter().map(|c| c.phi_width * (model.moment(c.mu_high, 1) - model.moment(c.mu_low, 1))).collect();
     let total: f64 = weights.iter().sum();

@@ -226,3 +226,90 @@ fn cie_general_cells_light_planes_as_the_sky_does() {
     let north: f64 = s.iter().map(|b| b.on(DVec3::Y)[0]).sum();
     assert!(south > 2.0 * north, "the sun is south: {south} vs {north}");
 }
+
+/// The Perez sky's coefficients `a … e` in every clearness bin (the overcast bin's own `c` and
+/// `d`; bin 2 with a brightness below 0.2, taken as 0.2) against Radiance's `gendaylit`, an
+/// independent implementation (2.5, from pyradiance 1.3.1, `gendaylit -ang ALT 0 -P ε Δ -O 1`,
+/// its sky function's arguments A3–A7, printed to 6 decimals from a table held in `f32`).
+#[test]
+fn perez_coefficients_match_gendaylit() {
+    // (ε, Δ, solar altitude in degrees) → [a, b, c, d, e].
+    let cases: [(f64, f64, f64, [f64; 5]); 8] = [
+        (1.03, 0.15, 30.0, [0.816731, -0.594625, 0.551433, -0.446237, -0.024545]),
+        (1.1, 0.1, 45.0, [-1.373014, -0.815314, 8.384407, -2.318136, 0.204070]),
+        (1.3, 0.3, 60.0, [-0.960675, -0.981856, 12.035852, -3.437929, 0.106621]),
+        (1.7, 0.25, 20.0, [-1.210763, -0.653498, 11.325085, -3.178683, 0.031269]),
+        (2.2, 0.35, 50.0, [-1.155849, -1.210129, 11.887587, -3.018874, 0.002099]),
+        (3.2, 0.25, 40.0, [-0.777373, -0.403645, 12.988751, -3.420259, 0.253007]),
+        (5.0, 0.2, 35.0, [-0.977523, -0.288305, 14.082526, -3.848130, 0.474213]),
+        (8.0, 0.12, 55.0, [-0.954910, -0.160829, 20.730378, -5.336102, 1.371540]),
+    ];
+    for (eps, delta, altitude, expected) in cases {
+        let k = PerezSky::new(eps, delta, (90.0 - altitude).to_radians(), 0.0).unwrap().coefficients();
+        for (i, (&ours, &theirs)) in k.iter().zip(&expected).enumerate() {
+            assert!((ours - theirs).abs() < 2e-5 * theirs.abs().max(1.0), "ε {eps} Δ {delta}: coefficient {i} {ours} vs {theirs}");
+        }
+    }
+    assert!(PerezSky::new(0.9, 0.2, 0.5, 0.0).is_err() && PerezSky::new(13.0, 0.2, 0.5, 0.0).is_err());
+    assert!(PerezSky::new(3.0, 0.005, 0.5, 0.0).is_err() && PerezSky::new(3.0, 0.7, 0.5, 0.0).is_err());
+    assert!(PerezSky::new(3.0, 0.2, 1.6, 0.0).is_err(), "the sun below the horizon");
+}
+
+/// Clearness and brightness from irradiances against `gendaylit -ang ALT 0 -W DNI DHI` (it prints
+/// them to 4 decimals; given angles, it puts the sun at the distance of day 0, whose eccentricity
+/// correction is day 1's within 2e-5).
+#[test]
+fn perez_parameters_match_gendaylit() {
+    for (dni, dhi, altitude, eps, delta) in
+        [(600.0, 120.0, 40.0, 3.9554, 0.1317), (150.0, 300.0, 25.0, 1.1984, 0.4991), (850.0, 90.0, 60.0, 9.2166, 0.0734)]
+    {
+        let (e, d) = perez_parameters(dni, dhi, (90.0f64 - altitude).to_radians(), 1).unwrap();
+        assert!((e - eps).abs() < 6e-5 && (d - delta).abs() < 6e-5, "{dni} {dhi} {altitude}: ({e}, {d}) vs ({eps}, {delta})");
+    }
+    assert!(perez_parameters(100.0, 0.0, 0.5, 150).is_err() && perez_parameters(100.0, 50.0, 1.7, 150).is_err());
+}
+
+/// A Perez sky's cells send the diffuse horizontal irradiance to a horizontal plane in every bin,
+/// and light vertical planes as a fine midpoint rule over the same distribution does (within 1%);
+/// a clear sky is brighter toward the sun.
+#[test]
+fn perez_cells_light_planes_as_the_sky_does() {
+    let site = Site::default();
+    let (zs, azs) = (50f64.to_radians(), std::f64::consts::PI);
+    for eps in [1.0, 1.1, 1.3, 1.7, 2.2, 3.2, 5.0, 8.0] {
+        let s = sky(SkyModel::Perez(PerezSky::new(eps, 0.2, zs, azs).unwrap()), [100.0; 3], 145, &site).unwrap();
+        let h: f64 = s.iter().map(|b| b.on(DVec3::Z)[0]).sum();
+        assert!((h - 100.0).abs() < 1e-9, "ε {eps}: {h}");
+    }
+    for eps in [1.03, 3.2, 8.0] {
+        let perez = PerezSky::new(eps, 0.15, zs, azs).unwrap();
+        let s = sky(SkyModel::Perez(perez), [1.0; 3], 145, &site).unwrap();
+        let (nt, np) = (1500, 3000);
+        let (dt, dp) = (std::f64::consts::FRAC_PI_2 / f64::from(nt), std::f64::consts::TAU / f64::from(np));
+        let normals = [-DVec3::Y, DVec3::Y, DVec3::X, -DVec3::X];
+        let (mut fine, mut horizontal) = ([0.0; 4], 0.0);
+        for i in 0..nt {
+            let th = (f64::from(i) + 0.5) * dt;
+            for j in 0..np {
+                let ph = (f64::from(j) + 0.5) * dp;
+                let w = perez.relative_luminance(th, ph) * th.sin() * dt * dp;
+                let d = DVec3::new(th.sin() * ph.sin(), th.sin() * ph.cos(), th.cos());
+                horizontal += w * d.z;
+                for (e, n) in fine.iter_mut().zip(&normals) {
+                    *e += w * d.dot(*n).max(0.0);
+                }
+            }
+        }
+        for (k, n) in normals.iter().enumerate() {
+            let cells: f64 = s.iter().map(|b| b.on(*n)[0]).sum();
+            let exact = fine[k] / horizontal;
+            println!("ε {eps}, normal {n}: cells {cells:.5} fine {exact:.5} ({:+.2}%)", 100.0 * (cells / exact - 1.0));
+            assert!((cells - exact).abs() < 0.01 * exact, "ε {eps}, normal {n}: cells {cells} vs {exact}");
+        }
+        if eps > 3.0 {
+            let south: f64 = s.iter().map(|b| b.on(-DVec3::Y)[0]).sum();
+            let north: f64 = s.iter().map(|b| b.on(DVec3::Y)[0]).sum();
+            assert!(south > 1.5 * north, "ε {eps}: the sun is south: {south} vs {north}");
+        }
+    }
+}

@@ -60,10 +60,11 @@ pub(super) enum SkyModelName {
     Uniform,
     CieOvercast,
     CieGeneral,
+    Perez,
 }
 
-/// `[sky]`: a radiance model (a CIE general sky with its `type`), the diffuse horizontal
-/// irradiance and the number of cells.
+/// `[sky]`: a radiance model (a CIE general sky with its `type`, a Perez sky with its `clearness`
+/// and `brightness`), the diffuse horizontal irradiance and the number of cells.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SkySpec {
@@ -71,6 +72,10 @@ pub(super) struct SkySpec {
     model: SkyModelName,
     #[serde(default, rename = "type")]
     sky_type: Option<u8>,
+    #[serde(default)]
+    clearness: Option<f64>,
+    #[serde(default)]
+    brightness: Option<f64>,
     diffuse_horizontal: ColorSpec,
     #[serde(default = "directions_default")]
     directions: u32,
@@ -288,21 +293,38 @@ pub(super) fn resolve(input: &BandsInput<'_>, path: &Path, line: usize) -> Resul
     Ok(Bands { names, declared: input.bands.is_some(), materials, site, sun, sun_report, sky })
 }
 
-/// The sky model `[sky]` names; a CIE general sky takes the sun's position from `[sun]`.
+/// The sky model `[sky]` names; a CIE general or a Perez sky takes the sun's position from `[sun]`.
 fn sky_model(s: &SkySpec, sun: Option<&SunReport>, site: &Site) -> Result<SkyModel, String> {
-    match (s.model, s.sky_type) {
-        (SkyModelName::Uniform, None) => Ok(SkyModel::Uniform),
-        (SkyModelName::CieOvercast, None) => Ok(SkyModel::CieOvercast),
-        (SkyModelName::CieGeneral, Some(t)) => {
-            let Some(sun) = sun else {
-                return Err("model \"cie-general\" needs the sun's position: give [sun] (`direct_normal = 0` leaves its beam out)".into());
-            };
-            let to_sun = -DVec3::from(sun.toward);
-            let zenith = to_sun.dot(site.up).clamp(-1.0, 1.0).acos();
-            let azimuth = to_sun.dot(site.east()).atan2(to_sun.dot(site.north));
+    let perez = (s.clearness, s.brightness);
+    if s.model != SkyModelName::Perez && (perez.0.is_some() || perez.1.is_some()) {
+        return Err("`clearness` and `brightness` apply to model = \"perez\" only".into());
+    }
+    if s.model != SkyModelName::CieGeneral && s.sky_type.is_some() {
+        return Err("`type` applies to model = \"cie-general\" only".into());
+    }
+    // The sun's zenith angle and azimuth (clockwise from north) in the site's frame.
+    let sun_position = |model: &str| -> Result<(f64, f64), String> {
+        let Some(sun) = sun else {
+            return Err(format!("model \"{model}\" needs the sun's position: give [sun] (`direct_normal = 0` leaves its beam out)"));
+        };
+        let to_sun = -DVec3::from(sun.toward);
+        let zenith = to_sun.dot(site.up).clamp(-1.0, 1.0).acos();
+        Ok((zenith, to_sun.dot(site.east()).atan2(to_sun.dot(site.north))))
+    };
+    match s.model {
+        SkyModelName::Uniform => Ok(SkyModel::Uniform),
+        SkyModelName::CieOvercast => Ok(SkyModel::CieOvercast),
+        SkyModelName::CieGeneral => {
+            let Some(t) = s.sky_type else { return Err("model \"cie-general\" needs `type` (1 to 15)".into()) };
+            let (zenith, azimuth) = sun_position("cie-general")?;
             Ok(SkyModel::CieGeneral(daylight::CieSky::new(t, zenith, azimuth).map_err(|e| e.to_string())?))
         }
-        (SkyModelName::CieGeneral, None) => Err("model \"cie-general\" needs `type` (1 to 15)".into()),
-        (_, Some(_)) => Err("`type` applies to model = \"cie-general\" only".into()),
+        SkyModelName::Perez => {
+            let (Some(clearness), Some(brightness)) = perez else {
+                return Err("model \"perez\" needs `clearness` and `brightness` (the sky's ε and Δ)".into());
+            };
+            let (zenith, azimuth) = sun_position("perez")?;
+            Ok(SkyModel::Perez(daylight::PerezSky::new(clearness, brightness, zenith, azimuth).map_err(|e| e.to_string())?))
+        }
     }
 }
