@@ -12,7 +12,7 @@
 //! the indicatrix is smooth through the sun).
 
 use super::quadrature::{light_vector, scaled_sources};
-use super::{DaylightError, DistantSource, Site, SkyCell};
+use super::{DaylightError, DistantSource, Site, SkyCell, check_sun_above, cos_angle_from_sun};
 
 /// A CIE general sky: its type (1–15) and the sun's position in the site's frame (radians;
 /// azimuth clockwise from north, as [`Site::direction`]).
@@ -43,12 +43,7 @@ impl CieSky {
         if !(1..=15).contains(&sky_type) {
             return Err(DaylightError(format!("CIE general sky type {sky_type}: give 1 to 15")));
         }
-        if !(sun_zenith.is_finite() && (0.0..std::f64::consts::FRAC_PI_2).contains(&sun_zenith) && sun_azimuth.is_finite()) {
-            return Err(DaylightError(format!(
-                "CIE general sky: the sun must be above the horizon (zenith angle {:.2}°)",
-                sun_zenith.to_degrees()
-            )));
-        }
+        check_sun_above("CIE general sky", sun_zenith, sun_azimuth)?;
         Ok(CieSky { sky_type, sun_zenith, sun_azimuth })
     }
 
@@ -66,10 +61,8 @@ impl CieSky {
             if cz <= 0.0 { 1.0 } else { 1.0 + a * (b / cz).exp() }
         };
         let indicatrix = |chi: f64| 1.0 + c * ((d * chi).exp() - (d * std::f64::consts::FRAC_PI_2).exp()) + e * chi.cos().powi(2);
-        let (zs, az) = (self.sun_zenith, self.sun_azimuth);
-        let cos_chi = zs.cos() * zenith.cos() + zs.sin() * zenith.sin() * (azimuth - az).cos();
-        let chi = cos_chi.clamp(-1.0, 1.0).acos();
-        gradation(zenith) * indicatrix(chi) / (gradation(0.0) * indicatrix(zs))
+        let chi = cos_angle_from_sun(self.sun_zenith, self.sun_azimuth, zenith, azimuth).acos();
+        gradation(zenith) * indicatrix(chi) / (gradation(0.0) * indicatrix(self.sun_zenith))
     }
 
     /// The sky as one distant source per cell, delivering `diffuse_horizontal` to an

@@ -65,6 +65,21 @@ fn check_levels(what: &str, v: &[f64; 3]) -> Result<(), DaylightError> {
     Ok(())
 }
 
+/// A sky model (`what`, for the message) needs the sun above the horizon, at zenith angle
+/// `sun_zenith` and azimuth `sun_azimuth` (radians).
+fn check_sun_above(what: &str, sun_zenith: f64, sun_azimuth: f64) -> Result<(), DaylightError> {
+    if sun_zenith.is_finite() && (0.0..std::f64::consts::FRAC_PI_2).contains(&sun_zenith) && sun_azimuth.is_finite() {
+        return Ok(());
+    }
+    Err(DaylightError(format!("{what}: the sun must be above the horizon (zenith angle {:.2}°)", sun_zenith.to_degrees())))
+}
+
+/// The cosine of the angle between the sky point at `zenith`, `azimuth` and the sun at
+/// `sun_zenith`, `sun_azimuth` (radians; azimuths clockwise from north).
+fn cos_angle_from_sun(sun_zenith: f64, sun_azimuth: f64, zenith: f64, azimuth: f64) -> f64 {
+    (sun_zenith.cos() * zenith.cos() + sun_zenith.sin() * zenith.sin() * (azimuth - sun_azimuth).cos()).clamp(-1.0, 1.0)
+}
+
 fn any_perpendicular(n: DVec3) -> DVec3 {
     if n.x.abs() < 0.9 { DVec3::X.cross(n) } else { DVec3::Y.cross(n) }
 }

@@ -13,7 +13,7 @@
 //! irradiance, as every sky model's are.
 
 use super::quadrature::{light_vector, scaled_sources};
-use super::{DaylightError, DistantSource, Site, SkyCell};
+use super::{DaylightError, DistantSource, Site, SkyCell, check_sun_above, cos_angle_from_sun};
 
 /// A Perez all-weather sky: clearness `ε`, brightness `Δ`, and the sun's position in the site's
 /// frame (radians; azimuth clockwise from north, as [`Site::direction`]).
@@ -91,12 +91,7 @@ impl PerezSky {
         if !(brightness.is_finite() && (d0..=d1).contains(&brightness)) {
             return Err(DaylightError(format!("Perez sky: brightness {brightness} outside the model's range {d0} to {d1}")));
         }
-        if !(sun_zenith.is_finite() && (0.0..std::f64::consts::FRAC_PI_2).contains(&sun_zenith) && sun_azimuth.is_finite()) {
-            return Err(DaylightError(format!(
-                "Perez sky: the sun must be above the horizon (zenith angle {:.2}°)",
-                sun_zenith.to_degrees()
-            )));
-        }
+        check_sun_above("Perez sky", sun_zenith, sun_azimuth)?;
         Ok(PerezSky { clearness, brightness, sun_zenith, sun_azimuth })
     }
 
@@ -130,8 +125,7 @@ impl PerezSky {
     fn luminance_with(self, [a, b, c, d, e]: [f64; 5], zenith: f64, azimuth: f64) -> f64 {
         let cz = zenith.cos();
         let gradation = if cz <= 0.0 { 1.0 } else { 1.0 + a * (b / cz).exp() };
-        let (zs, az) = (self.sun_zenith, self.sun_azimuth);
-        let cos_gamma = (zs.cos() * cz + zs.sin() * zenith.sin() * (azimuth - az).cos()).clamp(-1.0, 1.0);
+        let cos_gamma = cos_angle_from_sun(self.sun_zenith, self.sun_azimuth, zenith, azimuth);
         let indicatrix = 1.0 + c * (d * cos_gamma.acos()).exp() + e * cos_gamma * cos_gamma;
         (gradation * indicatrix).max(0.0)
     }
@@ -167,9 +161,7 @@ pub fn perez_parameters(
             "Perez sky: direct normal {direct_normal} and diffuse horizontal {diffuse_horizontal} W/m² must be finite, the diffuse positive"
         )));
     }
-    if !(sun_zenith.is_finite() && (0.0..std::f64::consts::FRAC_PI_2).contains(&sun_zenith)) {
-        return Err(DaylightError(format!("Perez sky: the sun must be above the horizon (zenith angle {:.2}°)", sun_zenith.to_degrees())));
-    }
+    check_sun_above("Perez sky", sun_zenith, 0.0)?;
     let z3 = 1.041 * sun_zenith.powi(3);
     let clearness = ((diffuse_horizontal + direct_normal) / diffuse_horizontal + z3) / (1.0 + z3);
     let air_mass = 1.0 / (sun_zenith.cos() + 0.15 * (93.885 - sun_zenith.to_degrees()).powf(-1.253));

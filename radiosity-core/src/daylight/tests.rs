@@ -186,6 +186,31 @@ fn cie_general_luminance_follows_the_standard() {
     assert!(CieSky::new(12, 1.6, 0.0).is_err(), "the sun below the horizon");
 }
 
+/// Planes facing south (toward a sun in the south), north, east and west.
+const PLANES: [DVec3; 4] = [DVec3::NEG_Y, DVec3::Y, DVec3::X, DVec3::NEG_X];
+
+/// The irradiance of each of [`PLANES`] over a horizontal plane's, from the sky luminance
+/// `luminance(zenith, azimuth)` by a fine midpoint rule over the hemisphere (1500 × 3000 cells):
+/// the reference a sky's cells are held to.
+fn fine_plane_irradiance(luminance: impl Fn(f64, f64) -> f64) -> [f64; 4] {
+    let (nt, np) = (1500, 3000);
+    let (dt, dp) = (std::f64::consts::FRAC_PI_2 / f64::from(nt), std::f64::consts::TAU / f64::from(np));
+    let (mut fine, mut horizontal) = ([0.0; 4], 0.0);
+    for i in 0..nt {
+        let th = (f64::from(i) + 0.5) * dt;
+        for j in 0..np {
+            let ph = (f64::from(j) + 0.5) * dp;
+            let w = luminance(th, ph) * th.sin() * dt * dp;
+            let d = DVec3::new(th.sin() * ph.sin(), th.sin() * ph.cos(), th.cos());
+            horizontal += w * d.z;
+            for (e, n) in fine.iter_mut().zip(&PLANES) {
+                *e += w * d.dot(*n).max(0.0);
+            }
+        }
+    }
+    fine.map(|e| e / horizontal)
+}
+
 /// A clear sky's cells against a fine midpoint rule over the hemisphere of the same formula: the
 /// irradiance of planes facing south (toward the sun), north, east and west, over the
 /// horizontal's; the 145 cells within 1%, and every type sends the diffuse horizontal irradiance
@@ -201,25 +226,8 @@ fn cie_general_cells_light_planes_as_the_sky_does() {
     }
     let clear = CieSky::new(12, zs, azs).unwrap();
     let s = sky(SkyModel::CieGeneral(clear), [1.0; 3], 145, &site).unwrap();
-    let (nt, np) = (1500, 3000);
-    let (dt, dp) = (std::f64::consts::FRAC_PI_2 / f64::from(nt), std::f64::consts::TAU / f64::from(np));
-    let normals = [-DVec3::Y, DVec3::Y, DVec3::X, -DVec3::X];
-    let (mut fine, mut horizontal) = ([0.0; 4], 0.0);
-    for i in 0..nt {
-        let th = (f64::from(i) + 0.5) * dt;
-        for j in 0..np {
-            let ph = (f64::from(j) + 0.5) * dp;
-            let w = clear.relative_luminance(th, ph) * th.sin() * dt * dp;
-            let d = DVec3::new(th.sin() * ph.sin(), th.sin() * ph.cos(), th.cos());
-            horizontal += w * d.z;
-            for (e, n) in fine.iter_mut().zip(&normals) {
-                *e += w * d.dot(*n).max(0.0);
-            }
-        }
-    }
-    for (k, n) in normals.iter().enumerate() {
+    for (n, exact) in PLANES.iter().zip(fine_plane_irradiance(|th, ph| clear.relative_luminance(th, ph))) {
         let cells: f64 = s.iter().map(|b| b.on(*n)[0]).sum();
-        let exact = fine[k] / horizontal;
         assert!((cells - exact).abs() < 0.01 * exact, "normal {n}: cells {cells} vs {exact}");
     }
     let south: f64 = s.iter().map(|b| b.on(-DVec3::Y)[0]).sum();
@@ -284,25 +292,8 @@ fn perez_cells_light_planes_as_the_sky_does() {
     for eps in [1.03, 3.2, 8.0] {
         let perez = PerezSky::new(eps, 0.15, zs, azs).unwrap();
         let s = sky(SkyModel::Perez(perez), [1.0; 3], 145, &site).unwrap();
-        let (nt, np) = (1500, 3000);
-        let (dt, dp) = (std::f64::consts::FRAC_PI_2 / f64::from(nt), std::f64::consts::TAU / f64::from(np));
-        let normals = [-DVec3::Y, DVec3::Y, DVec3::X, -DVec3::X];
-        let (mut fine, mut horizontal) = ([0.0; 4], 0.0);
-        for i in 0..nt {
-            let th = (f64::from(i) + 0.5) * dt;
-            for j in 0..np {
-                let ph = (f64::from(j) + 0.5) * dp;
-                let w = perez.relative_luminance(th, ph) * th.sin() * dt * dp;
-                let d = DVec3::new(th.sin() * ph.sin(), th.sin() * ph.cos(), th.cos());
-                horizontal += w * d.z;
-                for (e, n) in fine.iter_mut().zip(&normals) {
-                    *e += w * d.dot(*n).max(0.0);
-                }
-            }
-        }
-        for (k, n) in normals.iter().enumerate() {
+        for (n, exact) in PLANES.iter().zip(fine_plane_irradiance(|th, ph| perez.relative_luminance(th, ph))) {
             let cells: f64 = s.iter().map(|b| b.on(*n)[0]).sum();
-            let exact = fine[k] / horizontal;
             println!("ε {eps}, normal {n}: cells {cells:.5} fine {exact:.5} ({:+.2}%)", 100.0 * (cells / exact - 1.0));
             assert!((cells - exact).abs() < 0.01 * exact, "ε {eps}, normal {n}: cells {cells} vs {exact}");
         }

@@ -37,9 +37,10 @@ impl State {
         let top = solve::largest_non_emitting_mean(h, &sol.radiosity);
         let change = self.history.push(means);
         let last = last_level || self.stats.refused_for_memory > 0;
+        // The leaf coefficients go to the estimate, or are dropped here when none is made.
+        let fine = leaf.coefficients.take();
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
-            .then(|| estimate_error(h, links, sol, services.closed, &leaf.closure_changes, config, leaf.budget, leaf.coefficients.take()));
-        leaf.coefficients = None;
+            .then(|| estimate_error(h, links, sol, services.closed, &leaf.closure_changes, config, leaf.budget, fine));
         let (estimated, irradiance_errors) = match estimated {
             Some((e, per_polygon, irradiance)) => (Some((e, per_polygon)), irradiance),
             None => (None, Vec::new()),

@@ -196,9 +196,7 @@ impl LeafCoefficients {
             closure_change: Vec::new(),
         };
         if closed {
-            let transfer = std::mem::take(&mut c.transfer);
-            c.close(cut, &transfer);
-            c.transfer = transfer;
+            c.close(cut);
         }
         c
     }
@@ -233,26 +231,23 @@ impl LeafCoefficients {
             start.push(start[start.len() - 1] + len);
         }
         let chain_entries = start[start.len() - 1];
-        // Every finer unknown below a coarse one, with the offset of the coarse chain in its own.
+        // Every coarse unknown has finer ones below it, whose chains end with its own.
         let fine_below = LeavesBelow::new(fine);
-        let mut below_ok = true;
-        for (i, &u) in unknowns.iter().enumerate() {
-            for &c in fine_below.below(u) {
-                let f = fine.unknown_of(c)?;
-                below_ok &= self.start[f + 1] - self.start[f] >= lens[i];
-            }
-            below_ok &= !fine_below.below(u).is_empty();
-        }
-        if !below_ok {
+        let chains_end_alike = unknowns.iter().zip(&lens).all(|(&u, &n)| {
+            let below = fine_below.below(u);
+            !below.is_empty() && below.iter().all(|&c| fine.unknown_of(c).is_some_and(|f| self.start[f + 1] - self.start[f] >= n))
+        });
+        if !chains_end_alike {
             return None;
         }
+        // A coarse unknown's coefficients: the area-weighted means of the finer unknowns' on the
+        // same links, the last `out.len()` of each finer chain.
         let mean = |u: ElementId, out: &mut [f64]| {
             let n = out.len();
             let mut area = 0.0;
             for &c in fine_below.below(u) {
                 let f = fine.unknown_of(c).expect("checked above");
-                let (a, b) = (self.start[f], self.start[f + 1]);
-                let from = a + (b - a - n);
+                let from = self.start[f + 1] - n;
                 let w = h.get(c).area;
                 for (j, o) in out.iter_mut().enumerate() {
                     *o += w * f64::from(self.coef.get(from + j));
@@ -262,38 +257,23 @@ impl LeafCoefficients {
             let inv = if area > 0.0 { 1.0 / area } else { 0.0 };
             out.iter_mut().for_each(|o| *o *= inv);
         };
-        let fill = |u: ElementId, n: usize, store: &mut dyn FnMut(usize, f32)| {
-            let mut acc = vec![0.0; n];
-            mean(u, &mut acc);
-            for (j, &x) in acc.iter().enumerate() {
-                store(j, x as f32);
-            }
-        };
         let coef = match precision {
-            Precision::Single => {
-                let mut v = vec![0.0f32; chain_entries];
-                fill_each(unknowns, &start, &mut v, |u, out| {
-                    let n = out.len();
-                    fill(u, n, &mut |j, x| out[j] = x);
-                });
-                Stored::Single(v)
-            }
-            Precision::Half => {
-                let mut v = vec![0u16; chain_entries];
-                fill_each(unknowns, &start, &mut v, |u, out| {
-                    let n = out.len();
-                    fill(u, n, &mut |j, x| out[j] = encode(x));
-                });
-                Stored::Half(v)
-            }
+            Precision::Single => Stored::Single(means_stored(unknowns, &start, &mean, |x| x)),
+            Precision::Half => Stored::Half(means_stored(unknowns, &start, &mean, encode)),
         };
-        // The finer chains are done with.
-        let mut this = self;
-        this.coef = Stored::Single(Vec::new());
-        this.start = Vec::new();
-        let this = this;
-        let chain = Chain { h, links, sorted: &this.sorted, range: &this.range, precision };
-        let (inside_start, inside) = inside_links(h, unknowns, &this.sorted, &this.range, links);
+        // The finer chains are done with; the rest of `self` is read below.
+        let LeafCoefficients {
+            sorted,
+            range,
+            transfer,
+            value: fine_value,
+            weight_leaf: fine_leaf,
+            weight: fine_weight,
+            shared: fine_shared,
+            ..
+        } = self;
+        let chain = Chain { h, links, sorted: &sorted, range: &range, precision };
+        let (inside_start, inside) = inside_links(h, unknowns, &sorted, &range, links);
         let mut receiver_total = vec![0.0; links.len()];
         for (i, w) in start.windows(2).enumerate() {
             let inside = &inside[inside_start[i] as usize..inside_start[i + 1] as usize];
@@ -317,7 +297,7 @@ impl LeafCoefficients {
             sums.clear();
             sums.resize(list.len(), 0.0);
             let mut p = 0;
-            for (&y, &w) in this.weighted_leaves(lo, hi, leaves) {
+            for (&y, &w) in fine_leaf[leaves..leaves + hi - lo].iter().zip(&fine_weight[lo..hi]) {
                 let u = unknowns[coarse.unknown_of(y)?];
                 while list.get(p).is_some_and(|&x| x != u) {
                     p += 1;
@@ -332,7 +312,7 @@ impl LeafCoefficients {
                 value[k] = SourceValue::Leaf(unknowns[i]);
                 continue;
             }
-            value[k] = match this.value[k] {
+            value[k] = match fine_value[k] {
                 SourceValue::Leaf(e) => SourceValue::Leaf(e),
                 SourceValue::Own(lo, hi, leaves) => {
                     let begin = weight.len() as u32;
@@ -343,7 +323,7 @@ impl LeafCoefficients {
                     if let Some(&j) = shared_of.get(&i) {
                         SourceValue::Shared(j)
                     } else {
-                        let (s, lo, hi, leaves) = this.shared[i as usize];
+                        let (s, lo, hi, leaves) = fine_shared[i as usize];
                         let begin = weight.len();
                         let at = aggregate(s, lo, hi, leaves, &mut weight)?;
                         shared.push((s, begin, weight.len(), at as usize));
@@ -353,7 +333,6 @@ impl LeafCoefficients {
                 }
             };
         }
-        let LeafCoefficients { sorted, range, transfer, .. } = this;
         let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
         Some(LeafCoefficients {
             sorted,
@@ -397,8 +376,8 @@ impl LeafCoefficients {
     /// too: 1e-4 of each wall's light counted twice, 0.26% of the power at ρ = 0.95) and quadrature
     /// leaves ~1e-5: scale each unknown's shares in all its links so that they sum to 1, and each
     /// link's receiver side with them. Energy is then conserved exactly.
-    fn close(&mut self, cut: &Cut<'_>, transfer: &[f64]) {
-        let h = cut.hierarchy();
+    fn close(&mut self, cut: &Cut<'_>) {
+        let (h, transfer) = (cut.hierarchy(), &self.transfer);
         let n = cut.len();
         // Delivered fraction of every unknown: Σ_links τ q_y / A_y.
         let mut delivered = vec![0.0; n];
@@ -608,4 +587,24 @@ fn add_receiver_totals(totals: &mut [f64], chain: &Chain<'_>, u: ElementId, insi
     for &(k, c) in inside {
         totals[k as usize] += area * c;
     }
+}
+
+/// The chain coefficients of `unknowns` (in order, `start` their offsets, length
+/// `unknowns.len() + 1`), each unknown's from `mean(unknown, its values)`, stored as `store`
+/// turns them, in parallel.
+fn means_stored<T: Clone + Default + Send>(
+    unknowns: &[ElementId],
+    start: &[usize],
+    mean: &(dyn Fn(ElementId, &mut [f64]) + Sync),
+    store: impl Fn(f32) -> T + Sync,
+) -> Vec<T> {
+    let mut v = vec![T::default(); start[start.len() - 1]];
+    fill_each(unknowns, start, &mut v, |u, out| {
+        let mut acc = vec![0.0; out.len()];
+        mean(u, &mut acc);
+        for (o, &x) in out.iter_mut().zip(&acc) {
+            *o = store(x as f32);
+        }
+    });
+    v
 }
