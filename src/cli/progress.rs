@@ -39,7 +39,11 @@ impl Reporter {
         if let (true, Progress::Level { level, report }) = (self.lines, &p) {
             let estimate = report.error_estimate.map_or(String::new(), |e| format!(", estimated error {:.2}%", 100.0 * e));
             let refined = report.polygons_refined.map_or(String::new(), |n| format!(", {n} polygons refined further"));
-            eprintln!("level {level}: {} links{estimate}{refined} ({:.1} s)", report.links, report.time_s);
+            let t = &report.phases;
+            eprintln!(
+                "level {level}: {} links{estimate}{refined} ({:.1} s; this level: refine {:.1} s, solve {:.1} s of which leaf operator {:.1} s, estimate {:.1} s)",
+                report.links, report.time_s, t.refine, t.solve, t.leaf_operator, t.estimate
+            );
         }
         let msg = match p {
             Progress::Refine { level, pass, links, pending } => {

@@ -12,8 +12,10 @@ pub struct StatsTimes {
     pub build: f64,
     /// Refinement.
     pub refine: f64,
-    /// Linear solves.
+    /// Linear solves, with the leaf-resolution coefficients they are made with.
     pub solve: f64,
+    /// Of `solve`: building the leaf-resolution coefficients.
+    pub leaf_operator: f64,
     /// The error estimate (solves on coarsened meshes, visibility noise) and the per-level power
     /// balance.
     pub estimate: f64,
@@ -360,6 +362,7 @@ impl Stats {
                 build: solved.timings.build,
                 refine: solved.timings.refine,
                 solve: solved.timings.solve,
+                leaf_operator: solved.timings.leaf_operator,
                 estimate: solved.timings.estimate,
                 repeats: None,
                 output,

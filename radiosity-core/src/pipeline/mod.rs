@@ -95,6 +95,7 @@ pub fn run_with_points(
     let mut state = State::new(h, timings);
     let (mut points, mut local) = (importance::Rounds::new(), local::LocalLevels::default());
     let (mut levels, mut solution, mut target_missed, mut staleness) = (Vec::new(), None, None, stop::Staleness::default());
+    let mut level_start = Timings::default();
     for level in 0..cx.n_levels + cx.max_rounds {
         let scale = cx.first_scale / config.level_step.powi((level - points.rounds - local.held_levels) as i32);
         // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
@@ -116,8 +117,10 @@ pub fn run_with_points(
             change: est.change,
             error_estimate: est.estimate,
             time_s: t0.elapsed().as_secs_f64(),
+            phases: state.timings.since(&level_start),
             polygons_refined: local.polygons_refined.take(),
         };
+        level_start = state.timings;
         progress(Progress::Level { level: level + 1, report });
         let previous = levels.last().copied();
         levels.push(report);

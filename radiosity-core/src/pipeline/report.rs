@@ -11,14 +11,31 @@ pub struct Timings {
     pub build: f64,
     /// Refinement (oracle calls, form factors, visibility).
     pub refine: f64,
-    /// Linear solves.
+    /// Linear solves, with the leaf-resolution coefficients they are made with.
     pub solve: f64,
+    /// Of [`Timings::solve`]: building the leaf-resolution coefficients.
+    pub leaf_operator: f64,
     /// The error estimate (the solves on coarsened meshes, the visibility noise) and, with
     /// daylight, the power balance measured per level.
     pub estimate: f64,
     /// The importance rounds for calculation points and grids (their gathers, subdivisions and
     /// solves; see [`run_with_points`]).
     pub importance: f64,
+}
+
+impl Timings {
+    /// The time spent per phase since `earlier` (taken from the same run).
+    #[must_use]
+    pub fn since(&self, earlier: &Timings) -> Timings {
+        Timings {
+            build: self.build - earlier.build,
+            refine: self.refine - earlier.refine,
+            solve: self.solve - earlier.solve,
+            leaf_operator: self.leaf_operator - earlier.leaf_operator,
+            estimate: self.estimate - earlier.estimate,
+            importance: self.importance - earlier.importance,
+        }
+    }
 }
 
 /// Progress events for front ends.
@@ -79,6 +96,8 @@ pub struct LevelReport {
     pub error_estimate: Option<f64>,
     /// Wall time since the solve started, seconds.
     pub time_s: f64,
+    /// What this level took per phase, seconds (the build counts in the first level's).
+    pub phases: Timings,
     /// With daylight: how far the power balance is from closing, `|absorbed + escaped − incident
     /// − emitted|` over `incident + emitted`, largest over channels
     /// ([`crate::daylight::balance_gap`]); absent without.

@@ -74,6 +74,7 @@ impl State {
             self.passes,
             &mut leaf,
             config.stream_leaf_operator,
+            &mut self.timings.leaf_operator,
         );
         if let Some(c) = leaf.as_ref().filter(|c| !c.is_complete()) {
             let share = c.recomputed_share();
@@ -132,7 +133,8 @@ pub(super) fn update_data(data: &mut ElementData, h: &Hierarchy, links: &[Link],
 pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafCoefficients>, config: &Config) -> (Solution, usize, usize) {
     let sol = solve::solve(h, links, &ElementData::first_guess(h).radiosity, &config.solve);
     let first = sol.iterations;
-    let (sol, more, entries) = finish_solve(h, links, sol, config, config.leaf_operator_max_bytes, false, &|_| {}, 1, leaf, false);
+    let (sol, more, entries) =
+        finish_solve(h, links, sol, config, config.leaf_operator_max_bytes, false, &|_| {}, 1, leaf, false, &mut 0.0);
     (sol, first + more, entries)
 }
 
@@ -140,7 +142,7 @@ pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafC
 /// `leaf` (computed and kept there when absent, in the [`solve::Precision`] of the target error):
 /// `(solution, iterations, leaf entries)`. Over `max_bytes` of coefficients, with `stream` the coefficients beyond the budget are computed again
 /// at every iteration (the same answer, slower); without, one gather pass is done instead
-/// ([`solve::final_gather`]).
+/// ([`solve::final_gather`]). The seconds spent building the coefficients are added to `built_s`.
 #[allow(clippy::too_many_arguments)]
 fn finish_solve(
     h: &Hierarchy,
@@ -153,6 +155,7 @@ fn finish_solve(
     passes: usize,
     leaf: &mut Option<solve::LeafCoefficients>,
     stream: bool,
+    built_s: &mut f64,
 ) -> (Solution, usize, usize) {
     if !config.final_gather {
         return (solution, 0, 0);
@@ -163,7 +166,9 @@ fn finish_solve(
         let over_budget = entries.saturating_mul(precision.bytes()) > max_bytes;
         if stream || !over_budget {
             progress(Progress::LeafSolve { entries, over_budget });
+            let t = Instant::now();
             *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed, max_bytes, precision));
+            *built_s += t.elapsed().as_secs_f64();
         }
     }
     match leaf {

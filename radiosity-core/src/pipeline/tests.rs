@@ -82,3 +82,29 @@ fn initial_radiosity_of_clusters_is_the_mean_of_their_polygons() {
     let top = b[h.root as usize];
     assert!(top.iter().all(|&x| x > 0.0), "the root of a lit scene has a positive first guess: {top:?}");
 }
+
+/// Each level's phase times are that level's share of the run's: summed over the levels they give
+/// the run's, the leaf operator's within the solve's, and a level with a leaf-resolution solve
+/// spends some time building its coefficients.
+#[test]
+fn level_phase_times_sum_to_the_run_times() {
+    let scene = crate::scene::cornell_box();
+    let config = Config { target_error: Some(0.05), ..Config::default() };
+    let oracle = crate::refine::ClassicBf { eps: 0.05, b_ref: crate::refine::first_guess_max(&scene) };
+    let solved = run(&scene, &oracle, &config, &|_| {});
+    assert!(solved.levels.len() >= 2, "the test needs several levels: {}", solved.levels.len());
+    let sum = |f: fn(&Timings) -> f64| solved.levels.iter().map(|l| f(&l.phases)).sum::<f64>();
+    let t = &solved.timings;
+    for (name, total, summed) in [
+        ("refine", t.refine, sum(|p| p.refine)),
+        ("solve", t.solve, sum(|p| p.solve)),
+        ("leaf operator", t.leaf_operator, sum(|p| p.leaf_operator)),
+        ("estimate", t.estimate, sum(|p| p.estimate)),
+    ] {
+        assert!((total - summed).abs() <= 1e-9 * total.max(1.0), "{name}: run {total} s, levels {summed} s");
+    }
+    for l in &solved.levels {
+        let p = &l.phases;
+        assert!(p.leaf_operator > 0.0 && p.leaf_operator <= p.solve, "leaf operator {} s of solve {} s", p.leaf_operator, p.solve);
+    }
+}
