@@ -166,7 +166,8 @@ fn tiny_bright_source_near_a_corner() {
 /// Local levels (the default) refine, from the third level on, only the polygons over half the
 /// target and those that light them: fewer links than refining every polygon at every level, with
 /// the estimate still not below the true error and the target still met (Ward's room: 2,779
-/// links for 3,331; the corner room of ρ 0.3: 2,875 for 4,627, 2026-12-06).
+/// links for 3,331; the corner room of ρ 0.3: 2,875 for 4,627, 2026-12-06). A local level
+/// examines again only the links whose thresholds it tightened, and keeps the others as they were.
 #[test]
 fn local_levels_take_fewer_links_and_stay_honest() {
     for name in ["ward-room", "corner-room-rho0.3", "corner-room-rho0.7", "corner-room-rho0.95"] {
@@ -180,6 +181,15 @@ fn local_levels_take_fewer_links_and_stay_honest() {
             assert!(truth <= DEFAULT_TARGET, "{name} local {local_levels}: true error {truth:.3e}");
             assert!(estimate >= truth, "{name} local {local_levels}: estimate {estimate:.3e} below the true error {truth:.3e}");
             links.push(solved.links.len());
+            if local_levels {
+                let mut local = 0;
+                for w in solved.levels.windows(2).filter(|w| w[1].polygons_refined.is_some()) {
+                    let (before, level) = (&w[0], &w[1]);
+                    assert!(level.links_kept_unexamined < before.links, "{name}: {level:?}");
+                    local += usize::from(level.links_kept_unexamined > 0);
+                }
+                assert!(local > 0, "{name}: no local level kept a link unexamined");
+            }
         }
         assert!(links[0] < links[1], "{name}: local levels {} links, global {}", links[0], links[1]);
     }

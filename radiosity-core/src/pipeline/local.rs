@@ -22,7 +22,8 @@ impl LocalLevels {
     /// After a level over `target`: marks the polygons whose own estimate (of their mean radiosity,
     /// relative to the largest mean `top`, or of their mean irradiance in `irradiance_errors`) is
     /// over [`LOCAL_SHARE_OF_TARGET`] of it, and refines them and their sources further
-    /// ([`local_refinement`]) at the same scale. When none is over, every polygon is refined.
+    /// ([`local_refinement`]) at the same scale; the next level examines only the links whose
+    /// thresholds this tightened (`State::examine`). When none is over, every polygon is refined.
     pub(super) fn refine_over_target(
         &mut self,
         state: &mut State,
@@ -32,6 +33,7 @@ impl LocalLevels {
         target: f64,
         level_step: f64,
     ) {
+        state.examine = None;
         let share = LOCAL_SHARE_OF_TARGET * target;
         let over: Vec<bool> = state
             .polygon_errors
@@ -49,9 +51,14 @@ impl LocalLevels {
             for p in (0..touched.len()).filter(|&p| touched[p]) {
                 state.polygon_factor[p] /= level_step;
             }
+            let before = {
+                state.data.importance.resize(state.h.len(), 1.0);
+                state.data.importance.clone()
+            };
             for e in elements {
                 state.data.tighten_subtree(&state.h, e, 1.0 / level_step);
             }
+            state.examine = Some(before.iter().zip(&state.data.importance).map(|(a, b)| a != b).collect());
             self.polygons_refined = Some(touched.iter().filter(|&&o| o).count());
             // A source refined in part keeps its floor (the largest of its changes since it
             // was last over) like one left as it was.

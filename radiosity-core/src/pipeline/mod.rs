@@ -95,18 +95,25 @@ pub fn run_with_points(
     let mut state = State::new(h, timings);
     let (mut points, mut local) = (importance::Rounds::new(), local::LocalLevels::default());
     let (mut levels, mut solution, mut target_missed, mut staleness) = (Vec::new(), None, None, stop::Staleness::default());
-    let mut level_start = Timings::default();
+    let (mut level_start, mut level_start_calls) = (Timings::default(), 0);
+    // Whether the refinement data still reflect the solution before the last level's: read only
+    // where another level or an importance round follows (the last level's would be unused).
+    let mut data_stale = false;
     for level in 0..cx.n_levels + cx.max_rounds {
+        if std::mem::take(&mut data_stale) {
+            state.read_level_solution(&cx, level - 1, solution.as_ref().expect("solved above"));
+        }
         let scale = cx.first_scale / config.level_step.powi((level - points.rounds - local.held_levels) as i32);
         // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
         let at = Level { index: level, scale, limits: points.limits(config) };
         // Refine → solve rounds, then the leaf-resolution solve.
         let sol = refine_and_solve(&cx, &mut state, at, &mut points);
+        state.examine = None;
         let mut leaf = state.leaf_solve(&cx, sol);
         // Estimate (first, while the leaf coefficients it reuses are held), and report the level.
         let last_level = level - points.rounds + 1 == cx.n_levels;
         let est = state.estimate_level(&cx, &mut leaf, last_level);
-        state.read_level_solution(&cx, level, &leaf.solution);
+        data_stale = true;
         let report = LevelReport {
             balance_gap: est.balance_gap,
             points_error: None,
@@ -114,13 +121,15 @@ pub fn run_with_points(
             elements: state.h.len(),
             leaves: state.h.leaves().count(),
             links: state.links.len(),
+            oracle_calls: state.stats.oracle_calls - level_start_calls,
+            links_kept_unexamined: std::mem::take(&mut state.kept_unexamined),
             change: est.change,
             error_estimate: est.estimate,
             time_s: t0.elapsed().as_secs_f64(),
             phases: state.timings.since(&level_start),
             polygons_refined: local.polygons_refined.take(),
         };
-        level_start = state.timings;
+        (level_start, level_start_calls) = (state.timings, state.stats.oracle_calls);
         progress(Progress::Level { level: level + 1, report });
         let previous = levels.last().copied();
         levels.push(report);
@@ -139,6 +148,9 @@ pub fn run_with_points(
             }
             // Point sets: an importance round, a level of its own when it refined something.
             let sol = solution.as_ref().expect("solved above");
+            if std::mem::take(&mut data_stale) {
+                state.read_level_solution(&cx, level, sol);
+            }
             if points.run(&cx, &mut state, sol, levels.last_mut(), estimate, target, scale) {
                 continue;
             }
@@ -266,6 +278,13 @@ struct State {
     quadrature: Vec<u8>,
     /// Under local levels, each polygon's factor on its direct light's tolerance (empty: none).
     polygon_factor: Vec<f64>,
+    /// Under a local level, per element, whether the links it receives are examined again: those
+    /// whose threshold the level tightened, and every element made after the mask (`None`: every
+    /// link). The other links were decided at the same threshold scale by the level before, and
+    /// are kept as they are.
+    examine: Option<Vec<bool>>,
+    /// Links the level's first pass kept without examining them (see `examine`).
+    kept_unexamined: usize,
     /// The levels' polygon means, for the change and the estimate's floor.
     history: solve::LevelHistory,
     /// The links.
@@ -294,6 +313,8 @@ impl State {
             data,
             quadrature: Vec::new(),
             polygon_factor: Vec::new(),
+            examine: None,
+            kept_unexamined: 0,
             history: solve::LevelHistory::new(emitting),
             links: Vec::new(),
             stats: RefineStats::default(),

@@ -89,6 +89,13 @@ pub struct LevelReport {
     pub leaves: usize,
     /// Links after the level.
     pub links: usize,
+    /// Links the oracle examined in this level's passes (existing links re-examined and new
+    /// candidates): under local levels, only those whose thresholds the level tightened are
+    /// examined again.
+    pub oracle_calls: u64,
+    /// Under a local level, the links its first pass kept without examining them (decided at the
+    /// same threshold scale by the level before, their thresholds not tightened); 0 otherwise.
+    pub links_kept_unexamined: usize,
     /// Largest change of a non-emitting polygon mean since the level before, relative to the
     /// largest such mean (`None` for the first level).
     pub change: Option<f64>,
