@@ -43,7 +43,7 @@ use crate::geom::DVec3;
 
 pub use crate::light::DistantSource;
 pub use backs::{open_backs, two_sided_where_backs_see_light};
-pub use balance::{Leaving, OutsideLinks, balance_gap, outside_links, power_incident, power_incident_on_backs, power_leaving};
+pub use balance::{Escapes, Leaving, OutsideLinks, balance_gap, outside_links, power_incident, power_incident_on_backs, power_leaving};
 pub use cie_general::{CIE_GENERAL_TYPES, CieSky};
 pub use distant::{DistantLight, FAR_REL};
 pub use perez::{

@@ -304,3 +304,36 @@ fn perez_cells_light_planes_as_the_sky_does() {
         }
     }
 }
+
+/// The escape cells kept from one call to the next give what tracing every leaf again gives, bit
+/// for bit, open backs included, and a leaf split after a call has its children traced.
+#[test]
+fn kept_escapes_give_what_tracing_again_gives() {
+    use crate::scene::{Material, SceneBuilder};
+    let mut b = SceneBuilder::new(std::path::Path::new("test"), "test");
+    let m = b.material(Material::diffuse("grey", [0.5; 3])).unwrap();
+    let g = b.group("g");
+    let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    // A ground, and a one-sided face above part of it: its open back faces the ground.
+    b.face(&[c(0., 0., 0.), c(5., 0., 0.), c(5., 2., 0.), c(0., 2., 0.)], m, g, 0).unwrap();
+    b.face(&[c(3., 0., 1.), c(4., 0., 1.), c(4., 1., 1.), c(3., 1., 1.)], m, g, 0).unwrap();
+    let scene = b.finish();
+    let mut h = crate::hierarchy::build(&scene, &crate::hierarchy::BuildConfig::default());
+    let caster = crate::visibility::RayCaster::new(&scene);
+    let open = open_backs(&h);
+    assert_eq!(open, [true, true], "both one-sided faces of an open scene");
+    let radiosity = |h: &crate::hierarchy::Hierarchy| vec![[1.0, 0.5, 0.25]; h.len()];
+    let mut kept = Escapes::default();
+    kept.cover(h.len());
+    let first = power_leaving(&h, &radiosity(&h), &caster, &open, &kept);
+    assert_eq!(first, power_leaving(&h, &radiosity(&h), &caster, &open, &Escapes::default()));
+    assert_eq!(kept.traced(), 2, "both faces traced");
+    assert!(first.escaped[0] > 0.0 && first.onto_backs[0] > 0.0, "{first:?}");
+    assert_eq!(power_leaving(&h, &radiosity(&h), &caster, &open, &kept), first, "read back");
+    assert!(h.subdivide(0));
+    kept.cover(h.len());
+    let split = power_leaving(&h, &radiosity(&h), &caster, &open, &kept);
+    assert_eq!(split, power_leaving(&h, &radiosity(&h), &caster, &open, &Escapes::default()));
+    assert_eq!(kept.traced(), 2 + 4, "the ground's children traced as well");
+    assert_ne!(split, first, "the children's quadrature points differ from their parent's");
+}

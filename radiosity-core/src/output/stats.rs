@@ -229,7 +229,8 @@ pub fn channel_powers_and_losses(solved: &crate::pipeline::Solved) -> ([BandPowe
     }
     let mut lost_by_polygon = Vec::new();
     if !solved.lights.distant.is_empty() {
-        let outside = crate::daylight::outside_links(h, &solved.lights.distant, &solved.solution.radiosity, &solved.caster);
+        let outside =
+            crate::daylight::outside_links(h, &solved.lights.distant, &solved.solution.radiosity, &solved.caster, &solved.escapes);
         for c in 0..3 {
             out[c].incident = outside.incident[c];
             out[c].escaped = outside.escaped[c];

@@ -52,8 +52,10 @@ impl State {
         });
         let estimate = estimated.as_ref().map(|e| e.0);
         self.polygon_errors = estimated.map(|e| e.1).unwrap_or_default();
-        let balance_gap = (!services.lights.distant.is_empty() && target_error.is_some())
-            .then(|| crate::daylight::balance_gap(h, &services.lights.distant, sol, &services.caster));
+        let balance_gap = (!services.lights.distant.is_empty() && target_error.is_some()).then(|| {
+            self.escapes.cover(h.len());
+            crate::daylight::balance_gap(h, &services.lights.distant, sol, &services.caster, &self.escapes)
+        });
         self.timings.estimate += t.elapsed().as_secs_f64();
         LevelEstimate { top, change, estimate, irradiance_errors, balance_gap }
     }

@@ -285,6 +285,8 @@ struct State {
     examine: Option<Vec<bool>>,
     /// Links the level's first pass kept without examining them (see `examine`).
     kept_unexamined: usize,
+    /// Where each leaf's escape cells go, traced once for the power balance of every level.
+    escapes: crate::daylight::Escapes,
     /// The levels' polygon means, for the change and the estimate's floor.
     history: solve::LevelHistory,
     /// The links.
@@ -315,6 +317,7 @@ impl State {
             polygon_factor: Vec::new(),
             examine: None,
             kept_unexamined: 0,
+            escapes: crate::daylight::Escapes::default(),
             history: solve::LevelHistory::new(emitting),
             links: Vec::new(),
             stats: RefineStats::default(),

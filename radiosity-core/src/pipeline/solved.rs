@@ -39,6 +39,9 @@ pub struct Solved {
     pub solution: Solution,
     /// Ray caster (for rendering), when visibility was used or requested.
     pub caster: RayCaster,
+    /// Where each leaf's escape cells go, as far as the levels' power balances traced them (the
+    /// output's balance reuses them).
+    pub escapes: crate::daylight::Escapes,
     /// Refinement counters summed over passes.
     pub refine_stats: RefineStats,
     /// Rays cast during refinement.
@@ -114,7 +117,7 @@ pub(super) fn assemble(
     target_missed: Option<TargetMissed>,
     points: Rounds,
 ) -> Solved {
-    let State { h, links, stats, passes, iterations, leaf_entries, over_budget, polygon_errors, timings, .. } = state;
+    let State { h, links, stats, passes, iterations, leaf_entries, over_budget, polygon_errors, timings, escapes, .. } = state;
     let mut solution = solution.expect("at least one level solves");
     // The luminaires' direct light is part of what each surface receives.
     for (irr, d) in solution.irradiance.iter_mut().zip(&h.direct) {
@@ -154,6 +157,7 @@ pub(super) fn assemble(
         polygon_errors,
         solution,
         caster: services.caster,
+        escapes,
         memory_limited: stats.refused_for_memory > 0,
         escape_fraction: services.escape_fraction,
         closed: services.closed,
