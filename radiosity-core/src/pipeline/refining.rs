@@ -21,39 +21,31 @@ impl State {
         let t = Instant::now();
         // Under a local level only the links whose thresholds it tightened are examined again;
         // the others are kept as the level before decided them, at the same threshold scale.
-        let (examined, kept) = match &self.examine {
-            Some(mask) => std::mem::take(&mut self.links).into_iter().partition(|l| mask.get(l.receiver as usize).copied().unwrap_or(true)),
-            None => (std::mem::take(&mut self.links), Vec::new()),
-        };
+        let examine = self.examine.as_deref();
         if pass == 1 {
-            self.kept_unexamined = kept.len();
+            self.kept_unexamined =
+                examine.map_or(0, |mask| self.links.iter().filter(|l| !mask.get(l.receiver as usize).copied().unwrap_or(true)).count());
         }
-        let limits = refine::RefineLimits { max_bytes: at.limits.max_bytes.saturating_sub(kept.len() * refine::BYTES_PER_LINK) };
-        let (new_links, s) = if examined.is_empty() && !kept.is_empty() {
-            (examined, refine::RefineStats::default())
-        } else {
-            refine::refine(
-                &mut self.h,
-                services.use_visibility.then_some(&services.caster),
-                config.visibility,
-                cx.oracle,
-                examined,
-                &mut self.data,
-                at.scale,
-                services.shafts(),
-                limits,
-                config.criterion,
-                cx.reflected_rays,
-                &|l, p| (cx.progress)(Progress::Refine { level: at.index + 1, pass, links: l, pending: p }),
-            )
-        };
+        let (new_links, s) = refine::refine(
+            &mut self.h,
+            services.use_visibility.then_some(&services.caster),
+            config.visibility,
+            cx.oracle,
+            std::mem::take(&mut self.links),
+            &mut self.data,
+            at.scale,
+            services.shafts(),
+            at.limits,
+            config.criterion,
+            cx.reflected_rays,
+            examine,
+            &|l, p| (cx.progress)(Progress::Refine { level: at.index + 1, pass, links: l, pending: p }),
+        );
         self.links = new_links;
-        self.links.extend(kept);
         for e in self.h.match_sides() {
             self.data.inherit(&self.h, e);
         }
         let mut s = s;
-        s.links = self.links.len() as u64;
         if config.criterion == refine::Criterion::Irradiance && services.use_visibility {
             let fresh = VisibilityConfig {
                 rays: config.criterion.kept_rays(config.visibility.rays),

@@ -107,8 +107,9 @@ enum Outcome {
 /// Refines `links` (or, when empty, the root self-link) with `oracle` until every candidate is linked
 /// or dropped. `data` holds what is known of each element; it is extended for new elements
 /// (children inherit from their parent, see [`super::ElementData::inherit`]); every threshold of
-/// the pass is scaled by `threshold_scale`. `progress` is called after each batch with
-/// (links so far, candidates pending).
+/// the pass is scaled by `threshold_scale`. With `examine`, only the links whose receiver it marks
+/// (elements beyond it count as marked) are examined again; the others are kept as they are.
+/// `progress` is called after each batch with (links so far, candidates pending).
 #[allow(clippy::too_many_arguments)]
 pub fn refine(
     h: &mut Hierarchy,
@@ -122,14 +123,19 @@ pub fn refine(
     limits: RefineLimits,
     criterion: super::Criterion,
     reflected_rays: u32,
+    examine: Option<&[bool]>,
     progress: &dyn Fn(u64, u64),
 ) -> (Vec<Link>, RefineStats) {
     let mut stats = RefineStats::default();
+    let examined = |l: &Link| examine.is_none_or(|mask| mask.get(l.receiver as usize).copied().unwrap_or(true));
+    let mut out = Vec::with_capacity(links.len().max(1024));
+    out.extend(links.iter().filter(|l| !examined(l)));
     let mut pending: Vec<Candidate> = if links.is_empty() {
         vec![Candidate { source: h.root, receiver: h.root, existing: None, cands: None, culled_diag: f64::INFINITY }]
     } else {
         links
             .iter()
+            .filter(|l| examined(l))
             .map(|l| Candidate {
                 source: l.source,
                 receiver: l.receiver,
@@ -139,7 +145,6 @@ pub fn refine(
             })
             .collect()
     };
-    let mut out = Vec::with_capacity(links.len().max(1024));
     drop(links);
     let senders = Senders::of(h);
     while !pending.is_empty() {
