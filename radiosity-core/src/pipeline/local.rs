@@ -33,7 +33,6 @@ impl LocalLevels {
         target: f64,
         level_step: f64,
     ) {
-        state.examine = None;
         let share = LOCAL_SHARE_OF_TARGET * target;
         let over: Vec<bool> = state
             .polygon_errors

@@ -101,7 +101,7 @@ pub fn run_with_points(
     let mut data_stale = false;
     for level in 0..cx.n_levels + cx.max_rounds {
         if std::mem::take(&mut data_stale) {
-            state.read_level_solution(&cx, level - 1, solution.as_ref().expect("solved above"));
+            state.read_level_solution(&cx, solution.as_ref().expect("solved above"));
         }
         let scale = cx.first_scale / config.level_step.powi((level - points.rounds - local.held_levels) as i32);
         // Importance rounds refine within their own cap (see `IMPORTANCE_MAX_GROWTH`).
@@ -122,7 +122,7 @@ pub fn run_with_points(
             leaves: state.h.leaves().count(),
             links: state.links.len(),
             oracle_calls: state.stats.oracle_calls - level_start_calls,
-            links_kept_unexamined: std::mem::take(&mut state.kept_unexamined),
+            links_kept_unexamined: std::mem::take(&mut state.kept_unexamined) as usize,
             change: est.change,
             error_estimate: est.estimate,
             time_s: t0.elapsed().as_secs_f64(),
@@ -149,7 +149,7 @@ pub fn run_with_points(
             // Point sets: an importance round, a level of its own when it refined something.
             let sol = solution.as_ref().expect("solved above");
             if std::mem::take(&mut data_stale) {
-                state.read_level_solution(&cx, level, sol);
+                state.read_level_solution(&cx, sol);
             }
             if points.run(&cx, &mut state, sol, levels.last_mut(), estimate, target, scale) {
                 continue;
@@ -284,7 +284,7 @@ struct State {
     /// are kept as they are.
     examine: Option<Vec<bool>>,
     /// Links the level's first pass kept without examining them (see `examine`).
-    kept_unexamined: usize,
+    kept_unexamined: u64,
     /// Where each leaf's escape cells go, traced once for the power balance of every level.
     escapes: crate::daylight::Escapes,
     /// The levels' polygon means, for the change and the estimate's floor.

@@ -19,13 +19,6 @@ impl State {
     pub(super) fn refine_pass(&mut self, cx: &Context<'_>, at: Level, pass: usize, importance_refused: Option<&mut u64>) -> u64 {
         let (config, services) = (cx.config, cx.services);
         let t = Instant::now();
-        // Under a local level only the links whose thresholds it tightened are examined again;
-        // the others are kept as the level before decided them, at the same threshold scale.
-        let examine = self.examine.as_deref();
-        if pass == 1 {
-            self.kept_unexamined =
-                examine.map_or(0, |mask| self.links.iter().filter(|l| !mask.get(l.receiver as usize).copied().unwrap_or(true)).count());
-        }
         let (new_links, s) = refine::refine(
             &mut self.h,
             services.use_visibility.then_some(&services.caster),
@@ -38,10 +31,15 @@ impl State {
             at.limits,
             config.criterion,
             cx.reflected_rays,
-            examine,
+            // Under a local level only the links whose thresholds it tightened are examined
+            // again; the others are kept as the level before decided them, at the same scale.
+            self.examine.as_deref(),
             &|l, p| (cx.progress)(Progress::Refine { level: at.index + 1, pass, links: l, pending: p }),
         );
         self.links = new_links;
+        if pass == 1 {
+            self.kept_unexamined = s.kept_unexamined;
+        }
         for e in self.h.match_sides() {
             self.data.inherit(&self.h, e);
         }
@@ -73,6 +71,7 @@ impl State {
         self.stats.form_factors += s.form_factors;
         self.stats.subdivided += s.subdivided;
         self.stats.dropped += s.dropped;
+        self.stats.kept_unexamined += s.kept_unexamined;
         match importance_refused {
             Some(refused) => *refused += s.refused_for_memory,
             None => self.stats.refused_for_memory += s.refused_for_memory,

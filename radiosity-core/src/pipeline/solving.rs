@@ -100,13 +100,11 @@ impl State {
         LeafSolved { solution: sol, closure_changes, budget: leaf_budget, coefficients }
     }
 
-    /// What the next level's refinement reads of the level's solution `sol` ([`update_data`]),
-    /// when level `level` (from 0) is not the last, or point sets may need importance rounds.
-    pub(super) fn read_level_solution(&mut self, cx: &Context<'_>, level: usize, sol: &Solution) {
+    /// What the next level's (or importance round's) refinement reads of the level's solution
+    /// `sol` ([`update_data`]); called only where one follows.
+    pub(super) fn read_level_solution(&mut self, cx: &Context<'_>, sol: &Solution) {
         let t = Instant::now();
-        if level + 1 < cx.n_levels || cx.has_points {
-            update_data(&mut self.data, &self.h, &self.links, sol, cx.config);
-        }
+        update_data(&mut self.data, &self.h, &self.links, sol, cx.config);
         self.timings.refine += t.elapsed().as_secs_f64();
     }
 }

@@ -40,6 +40,9 @@ pub struct RefineStats {
     pub subdivided: u64,
     /// Links dropped by the oracle or for a zero form factor.
     pub dropped: u64,
+    /// Links kept as they were without being examined (their receivers not marked by
+    /// `refine`'s `examine`).
+    pub kept_unexamined: u64,
     /// Subdivisions refused because refinement reached its memory budget
     /// ([`RefineLimits::max_bytes`]): those links were kept where they were.
     pub refused_for_memory: u64,
@@ -130,6 +133,7 @@ pub fn refine(
     let examined = |l: &Link| examine.is_none_or(|mask| mask.get(l.receiver as usize).copied().unwrap_or(true));
     let mut out = Vec::with_capacity(links.len().max(1024));
     out.extend(links.iter().filter(|l| !examined(l)));
+    stats.kept_unexamined = out.len() as u64;
     let mut pending: Vec<Candidate> = if links.is_empty() {
         vec![Candidate { source: h.root, receiver: h.root, existing: None, cands: None, culled_diag: f64::INFINITY }]
     } else {
