@@ -718,3 +718,38 @@ fn crossing_leaves_meet_the_target_and_absorb_what_the_photon_tracer_finds() {
         }
     }
 }
+
+/// A level's leaf-resolution coefficients take from the level before's those of a leaf on a link
+/// both have (`Config::reuse_leaf_coefficients`, the default): on a canopy of 200 transmitting
+/// leaves under the sun and the sky, solved to the default target over several levels, the
+/// solution is the one every coefficient computed anew gives, bit for bit, and the levels after
+/// the first took coefficients from the level before.
+#[test]
+fn reused_leaf_coefficients_give_the_same_solution_bit_for_bit() {
+    use radiosity::pipeline::{self, Config};
+    let (n, side, half, seed) = (200, 0.15, 2.5, 11);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("leaves.obj"), canopy_obj(n, side, half, seed, false)).unwrap();
+    let leaf = "reflectance = [0.10, 0.45]\ntransmittance = [0.05, 0.40]";
+    std::fs::write(dir.path().join("canopy.toml"), canopy_scene(leaf, "[0.10, 0.25]", true)).unwrap();
+    // As `radiosity solve` reads a scene file of daylight on plain geometry.
+    let (file, lighting) = radiosity::instancing::load_with_lighting(&dir.path().join("canopy.toml")).expect("the scene loads");
+    let mut scene = radiosity::instancing::flatten(&file, &radiosity::instancing::FlattenOptions::default()).unwrap();
+    scene.distant = lighting.bands.pack_distant(0);
+    radiosity::daylight::two_sided_where_backs_see_light(&mut scene);
+    let solve = |reuse: bool| {
+        let config = Config { target_error: Some(0.01), reuse_leaf_coefficients: reuse, ..Config::default() };
+        pipeline::run(&scene, &radiosity::refine::BfHand::default(), &config, &|_| {})
+    };
+    let (reusing, anew) = (solve(true), solve(false));
+    let reused: Vec<usize> = reusing.levels.iter().map(|l| l.leaf_coefficients_reused).collect();
+    eprintln!("levels {}, coefficients {}, reused per level {reused:?}", reusing.levels.len(), reusing.leaf_entries);
+    assert!(reusing.levels.len() >= 3, "the canopy takes several levels: {}", reusing.levels.len());
+    assert_eq!(reused[0], 0, "the first level has none before it");
+    assert!(reused[1..].iter().all(|&r| r > 0), "every later level took coefficients: {reused:?}");
+    assert!(anew.levels.iter().all(|l| l.leaf_coefficients_reused == 0));
+    assert_eq!(reusing.links.len(), anew.links.len());
+    assert_eq!(reusing.solution.radiosity, anew.solution.radiosity, "radiosity differs");
+    assert_eq!(reusing.solution.irradiance, anew.solution.irradiance, "irradiance differs");
+    assert_eq!(reusing.error_estimate, anew.error_estimate);
+}

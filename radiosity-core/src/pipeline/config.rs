@@ -64,6 +64,12 @@ pub struct Config {
     /// answer, slower); off: do one gather pass instead of the leaf-resolution solve (an
     /// approximation, what the instanced solver's local problems do to stay small).
     pub stream_leaf_operator: bool,
+    /// A level's leaf-resolution coefficients take from the level before's those of a leaf on a
+    /// link both have (the same leaf receiving from the same source with the same visibility and
+    /// form factor, through the same element: the same value, bit for bit) instead of computing
+    /// them again ([`solve::LeafCoefficients::for_cut_reusing`]); off: every level computes all
+    /// of them (the same answer, slower; the tests compare the two).
+    pub reuse_leaf_coefficients: bool,
     /// Estimate the solution's error ([`Solved::error_estimate`]).
     pub estimate_error: bool,
     /// Measure each element's radiosity variation after every solve ([`solve::element_data`]), for
@@ -101,6 +107,7 @@ impl Default for Config {
             final_gather: true,
             leaf_operator_max_bytes: solve::LEAF_OPERATOR_MAX_BYTES,
             stream_leaf_operator: true,
+            reuse_leaf_coefficients: true,
             estimate_error: true,
             measure_variation: true,
             detect_closure: true,

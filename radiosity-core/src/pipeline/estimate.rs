@@ -42,7 +42,10 @@ impl State {
         let estimated = (config.estimate_error && config.final_gather && (target_error.is_some() || last))
             .then(|| estimate_error(h, links, sol, services.closed, &leaf.closure_changes, config, leaf.budget, fine));
         let (estimated, irradiance_errors) = match estimated {
-            Some((e, per_polygon, irradiance)) => (Some((e, per_polygon)), irradiance),
+            Some(Estimated { estimate, per_polygon, irradiance_errors, reuse }) => {
+                self.chain_reuse = reuse;
+                (Some((estimate, per_polygon)), irradiance_errors)
+            }
             None => (None, Vec::new()),
         };
         // Under a target, at least what the last level changed (solve::LEVEL_CHANGE_SAFETY).
@@ -73,8 +76,9 @@ impl State {
 /// polygons (on Ward's room at eps 0.64 the estimate fell from 35% to 26% for a true 7.6%).
 /// The coarser solves' coefficients are made from `fine`, the solution's own, where it is given
 /// and they can be ([`solve::LeafCoefficients::coarsened`]), and anew otherwise.
-/// Returns the estimate, each polygon's share in W/m² of radiosity, and under the irradiance
-/// criterion each polygon's mean irradiance's share relative to the largest (empty otherwise).
+/// Returns the estimate, each polygon's share in W/m² of radiosity, under the irradiance
+/// criterion each polygon's mean irradiance's share relative to the largest (empty otherwise),
+/// and `fine`'s chain coefficients for the next level's ([`solve::ChainReuse`]).
 #[expect(clippy::too_many_arguments, reason = "the level's solution and what its estimate reads of it")]
 pub(super) fn estimate_error(
     h: &Hierarchy,
@@ -85,7 +89,7 @@ pub(super) fn estimate_error(
     config: &Config,
     max_bytes: usize,
     fine: Option<solve::LeafCoefficients>,
-) -> (f64, Vec<f64>, Vec<f64>) {
+) -> Estimated {
     // Under the irradiance criterion the estimate covers the polygons' mean irradiance as well.
     let irradiance = config.criterion == refine::Criterion::Irradiance;
     let results = crate::solve::polygon_results(h, sol);
@@ -99,11 +103,22 @@ pub(super) fn estimate_error(
     let mut h_means = vec![with_direct(results.clone())];
     // Each coarser cut's coefficients from the finer cut's where they can be.
     let mut finer = fine.map(|c| (solve::Cut::leaves(h), c));
+    let mut reuse = None;
     for levels in 1..=2 {
         let cut = solve::Cut::coarsened(h, levels);
-        let coefficients = finer.take().and_then(|(fine_cut, c)| c.coarsened(&fine_cut, &cut, links)).unwrap_or_else(|| {
-            solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error))
-        });
+        let coefficients = finer
+            .take()
+            .and_then(|(fine_cut, c)| {
+                let coarse = c.coarsened(&fine_cut, &cut, links);
+                // The solution's own chain coefficients serve the next level's too.
+                if levels == 1 {
+                    reuse = Some(c.into_reuse(&fine_cut, links));
+                }
+                coarse
+            })
+            .unwrap_or_else(|| {
+                solve::LeafCoefficients::for_cut(&cut, links, closed, max_bytes, solve::Precision::for_target(config.target_error))
+            });
         let op = solve::LeafOperator::for_cut(cut, links, &coefficients);
         let coarse = solve::solve_leaf_operator(&op, &sol.radiosity, &config.solve);
         drop(op);
@@ -159,5 +174,18 @@ pub(super) fn estimate_error(
     } else {
         Vec::new()
     };
-    (estimate, per_polygon, irradiance_errors)
+    Estimated { estimate, per_polygon, irradiance_errors, reuse }
+}
+
+/// What [`estimate_error`] returns.
+pub(super) struct Estimated {
+    /// The estimate.
+    pub(super) estimate: f64,
+    /// Each polygon's share, W/m² of radiosity.
+    pub(super) per_polygon: Vec<f64>,
+    /// Under the irradiance criterion each polygon's mean irradiance's share relative to the
+    /// largest (empty otherwise).
+    pub(super) irradiance_errors: Vec<f64>,
+    /// The leaf-resolution chain coefficients it was given, for the next level's.
+    pub(super) reuse: Option<solve::ChainReuse>,
 }

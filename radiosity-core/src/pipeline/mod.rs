@@ -123,6 +123,7 @@ pub fn run_with_points(
             links: state.links.len(),
             oracle_calls: state.stats.oracle_calls - level_start_calls,
             links_kept_unexamined: std::mem::take(&mut state.kept_unexamined) as usize,
+            leaf_coefficients_reused: std::mem::take(&mut state.leaf_entries_reused),
             change: est.change,
             error_estimate: est.estimate,
             time_s: t0.elapsed().as_secs_f64(),
@@ -299,6 +300,11 @@ struct State {
     iterations: usize,
     /// Coefficients of the last leaf-resolution operator.
     leaf_entries: usize,
+    /// The last level's leaf-resolution chain coefficients, for the next level's to take from
+    /// where its leaves and links are the same.
+    chain_reuse: Option<solve::ChainReuse>,
+    /// Chain coefficients taken from the level before, summed over levels.
+    leaf_entries_reused: usize,
     /// Levels whose leaf-resolution operator was over its budget.
     over_budget: Option<LeafOverBudget>,
     /// Per polygon, the last level's estimated error of its mean radiosity (empty without one).
@@ -324,6 +330,8 @@ impl State {
             passes: 0,
             iterations: 0,
             leaf_entries: 0,
+            chain_reuse: None,
+            leaf_entries_reused: 0,
             over_budget: None,
             polygon_errors: Vec::new(),
             timings,

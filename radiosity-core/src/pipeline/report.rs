@@ -96,6 +96,9 @@ pub struct LevelReport {
     /// Under a local level, the links its first pass kept without examining them (decided at the
     /// same threshold scale by the level before, their thresholds not tightened); 0 otherwise.
     pub links_kept_unexamined: usize,
+    /// Leaf-resolution chain coefficients this level took from the level before's (the same
+    /// leaf on the same link: the same value) instead of computing them.
+    pub leaf_coefficients_reused: usize,
     /// Largest change of a non-emitting polygon mean since the level before, relative to the
     /// largest such mean (`None` for the first level).
     pub change: Option<f64>,

@@ -62,7 +62,22 @@ impl State {
         let t = Instant::now();
         let budget = config.max_memory_bytes.saturating_sub(h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK);
         let leaf_budget = config.leaf_operator_max_bytes.min(budget);
-        let mut leaf = None;
+        // The level before's chain coefficients serve where leaves and links are the same.
+        let earlier = self.chain_reuse.take().filter(|_| config.reuse_leaf_coefficients);
+        let mut leaf = earlier.and_then(|earlier| {
+            build_leaf_coefficients(
+                h,
+                links,
+                config,
+                leaf_budget,
+                cx.services.closed,
+                cx.progress,
+                config.stream_leaf_operator,
+                Some(&earlier),
+                &mut self.timings.leaf_operator,
+            )
+        });
+        self.leaf_entries_reused += leaf.as_ref().map_or(0, solve::LeafCoefficients::reused_entries);
         let (sol, more_iterations, _) = finish_solve(
             h,
             links,
@@ -136,6 +151,35 @@ pub fn solve_links(h: &Hierarchy, links: &[Link], leaf: &mut Option<solve::LeafC
     (sol, first + more, entries)
 }
 
+/// The leaf-resolution coefficients of `links` at the leaves of `h`, in the [`solve::Precision`]
+/// of the target error, within `max_bytes` of stored coefficients, or beyond it with `stream`
+/// (`None` otherwise), taking from `earlier` what it holds of the same leaves on the same links;
+/// the seconds spent are added to `built_s`.
+#[allow(clippy::too_many_arguments)]
+fn build_leaf_coefficients(
+    h: &Hierarchy,
+    links: &[Link],
+    config: &Config,
+    max_bytes: usize,
+    closed: bool,
+    progress: &dyn Fn(Progress),
+    stream: bool,
+    earlier: Option<&solve::ChainReuse>,
+    built_s: &mut f64,
+) -> Option<solve::LeafCoefficients> {
+    let precision = solve::Precision::for_target(config.target_error);
+    let entries = solve::leaf_operator_entries(h, links);
+    let over_budget = entries.saturating_mul(precision.bytes()) > max_bytes;
+    if !config.final_gather || (over_budget && !stream) {
+        return None;
+    }
+    progress(Progress::LeafSolve { entries, over_budget });
+    let t = Instant::now();
+    let c = solve::LeafCoefficients::for_cut_reusing(&solve::Cut::leaves(h), links, closed, max_bytes, precision, earlier);
+    *built_s += t.elapsed().as_secs_f64();
+    Some(c)
+}
+
 /// The final gather step after the hierarchical solve, with the leaf-resolution coefficients of
 /// `leaf` (computed and kept there when absent, in the [`solve::Precision`] of the target error):
 /// `(solution, iterations, leaf entries)`. Over `max_bytes` of coefficients, with `stream` the coefficients beyond the budget are computed again
@@ -159,15 +203,7 @@ fn finish_solve(
         return (solution, 0, 0);
     }
     if leaf.is_none() {
-        let precision = solve::Precision::for_target(config.target_error);
-        let entries = solve::leaf_operator_entries(h, links);
-        let over_budget = entries.saturating_mul(precision.bytes()) > max_bytes;
-        if stream || !over_budget {
-            progress(Progress::LeafSolve { entries, over_budget });
-            let t = Instant::now();
-            *leaf = Some(solve::LeafCoefficients::for_cut(&solve::Cut::leaves(h), links, closed, max_bytes, precision));
-            *built_s += t.elapsed().as_secs_f64();
-        }
+        *leaf = build_leaf_coefficients(h, links, config, max_bytes, closed, progress, stream, None, built_s);
     }
     match leaf {
         Some(coefficients) => {

@@ -25,7 +25,9 @@ pub use estimate::{
 };
 pub use final_gather::{area_means, final_gather, top_down};
 pub use gmres::{GmresResult, gmres};
-pub use leaf::{HALF_MIN_TARGET, HALF_ROUNDING, LEAF_OPERATOR_MAX_BYTES, LeafCoefficients, LeafOperator, Precision, leaf_operator_entries};
+pub use leaf::{
+    ChainReuse, HALF_MIN_TARGET, HALF_ROUNDING, LEAF_OPERATOR_MAX_BYTES, LeafCoefficients, LeafOperator, Precision, leaf_operator_entries,
+};
 pub use operator::Operator;
 pub use polygon::{PolygonResult, polygon_results};
 pub use ranges::{VALUE_SERIES_FACTOR, element_data, leaf_value_errors};

@@ -3,6 +3,7 @@
 //! with its coefficients, stored or recomputed ([`Chain`]).
 
 use super::precision::Precision;
+use super::reuse::{ChainReuse, LinkKey};
 use super::weights::shape_form_factor;
 use crate::hierarchy::{ElementId, Hierarchy, NONE};
 use crate::refine::Link;
@@ -95,13 +96,19 @@ impl Chain<'_> {
         while a != NONE {
             let (lo, hi) = self.range[a as usize];
             for &k in &self.sorted[lo as usize..hi as usize] {
-                let l = &self.links[k as usize];
-                let ff = if a == leaf { l.ff } else { shape_form_factor(self.h, l.source, leaf) };
-                let c = ff * l.vis;
-                f(k, if c > 0.0 { c as f32 } else { 0.0 });
+                f(k, self.raw(leaf, a, &self.links[k as usize]));
             }
             a = self.h.get(a).parent;
         }
+    }
+
+    /// The coefficient of `leaf` on link `l`, received at `a` (the leaf or an ancestor), as
+    /// [`Chain::for_each_raw`] gives it: it depends on the two elements, the link's source, its
+    /// visibility and, at the leaf, its form factor, and on nothing else.
+    fn raw(&self, leaf: ElementId, a: ElementId, l: &Link) -> f32 {
+        let ff = if a == leaf { l.ff } else { shape_form_factor(self.h, l.source, leaf) };
+        let c = ff * l.vis;
+        if c > 0.0 { c as f32 } else { 0.0 }
     }
 
     /// [`Chain::for_each_raw`] with every value as it is applied in the chain's [`Precision`]: what
@@ -109,6 +116,59 @@ impl Chain<'_> {
     pub(super) fn for_each(&self, leaf: ElementId, mut f: impl FnMut(u32, f32)) {
         let p = self.precision;
         self.for_each_raw(leaf, |k, c| f(k, p.round(c)));
+    }
+
+    /// [`Chain::fill`] taking from `earlier` (the coefficients of an earlier level of the same
+    /// hierarchy, stored as `old`) every coefficient of an unknown that was one then, on a link
+    /// received at the same element from the same source with the same visibility and form
+    /// factor: what [`Chain::raw`] depends on, so the value is the one it would compute again.
+    /// Returns how many were taken.
+    pub(super) fn fill_reusing<T: Copy + Send + Sync>(
+        &self,
+        unknowns: &[ElementId],
+        start: &[usize],
+        coef: &mut [T],
+        store: impl Fn(f32) -> T + Sync,
+        earlier: &ChainReuse,
+        old: &[T],
+    ) -> usize {
+        let taken = std::sync::atomic::AtomicUsize::new(0);
+        fill_each(unknowns, start, coef, |u, out| {
+            let Some(i) = earlier.unknown_of(u) else {
+                let mut j = 0;
+                self.for_each_raw(u, |_, c| {
+                    out[j] = store(c);
+                    j += 1;
+                });
+                return;
+            };
+            let (mut j, mut from, mut n) = (0, earlier.start[i], 0);
+            let mut a = u;
+            while a != NONE {
+                let (lo, hi) = self.range[a as usize];
+                let (olo, ohi) = earlier.range.get(a as usize).map_or((0, 0), |&(l, h)| (l as usize, h as usize));
+                let mut p = olo;
+                for &k in &self.sorted[lo as usize..hi as usize] {
+                    let l = &self.links[k as usize];
+                    // Both runs are sorted by source.
+                    while p < ohi && earlier.keys[p].0 < l.source {
+                        p += 1;
+                    }
+                    out[j] = if p < ohi && earlier.keys[p] == LinkKey::of(l) {
+                        n += 1;
+                        p += 1;
+                        old[from + p - 1 - olo]
+                    } else {
+                        store(self.raw(u, a, l))
+                    };
+                    j += 1;
+                }
+                from += ohi - olo;
+                a = self.h.get(a).parent;
+            }
+            taken.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+        });
+        taken.into_inner()
     }
 
     /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets

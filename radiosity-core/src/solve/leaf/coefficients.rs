@@ -5,6 +5,7 @@
 
 use super::chain::{Chain, LeavesBelow, fill_each};
 use super::precision::{Precision, Stored, encode};
+use super::reuse::ChainReuse;
 use super::weights::{SourceWeights, own_weights, source_weights};
 use super::{
     CLOSURE_MAX, CLOSURE_MIN, CLOSURE_NOISE_MAX, LeafCoefficients, STREAM_BATCH_ENTRIES, SourceValue, WEIGHT_CHUNK, WEIGHT_CHUNK_ENTRIES,
@@ -32,6 +33,21 @@ impl LeafCoefficients {
     /// [`LeafCoefficients::stored_unknowns`]).
     #[must_use]
     pub fn for_cut(cut: &Cut<'_>, links: &[Link], closed: bool, max_bytes: usize, precision: Precision) -> LeafCoefficients {
+        LeafCoefficients::for_cut_reusing(cut, links, closed, max_bytes, precision, None)
+    }
+
+    /// [`LeafCoefficients::for_cut`] taking from `earlier` (an earlier level's, of the same run)
+    /// the chain coefficients it holds of the same unknown on the same link: the same values,
+    /// bit for bit, without their form factors ([`LeafCoefficients::reused_entries`] counts them).
+    #[must_use]
+    pub fn for_cut_reusing(
+        cut: &Cut<'_>,
+        links: &[Link],
+        closed: bool,
+        max_bytes: usize,
+        precision: Precision,
+        earlier: Option<&ChainReuse>,
+    ) -> LeafCoefficients {
         let h = cut.hierarchy();
         let LinksByReceiver { sorted, range, .. } = LinksByReceiver::new(h, links);
         let chain = Chain { h, links, sorted: &sorted, range: &range, precision };
@@ -50,15 +66,22 @@ impl LeafCoefficients {
             start.push(next);
         }
         let stored = start.len() - 1;
+        let mut reused = 0;
         let coef = match precision {
             Precision::Single => {
                 let mut v = vec![0.0f32; start[stored]];
-                chain.fill(&unknowns[..stored], &start, &mut v, |c| c);
+                match earlier.map(|e| (e, &e.coef)) {
+                    Some((e, Stored::Single(old))) => reused = chain.fill_reusing(&unknowns[..stored], &start, &mut v, |c| c, e, old),
+                    _ => chain.fill(&unknowns[..stored], &start, &mut v, |c| c),
+                }
                 Stored::Single(v)
             }
             Precision::Half => {
                 let mut v = vec![0u16; start[stored]];
-                chain.fill(&unknowns[..stored], &start, &mut v, encode);
+                match earlier.map(|e| (e, &e.coef)) {
+                    Some((e, Stored::Half(old))) => reused = chain.fill_reusing(&unknowns[..stored], &start, &mut v, encode, e, old),
+                    _ => chain.fill(&unknowns[..stored], &start, &mut v, encode),
+                }
                 Stored::Half(v)
             }
         };
@@ -182,6 +205,7 @@ impl LeafCoefficients {
             range,
             start,
             coef,
+            reused,
             chain_entries,
             inside_start,
             inside,
@@ -216,7 +240,7 @@ impl LeafCoefficients {
     /// (the closure has rescaled its weights to `fine`'s unknowns): there
     /// [`LeafCoefficients::for_cut`] builds them anew.
     #[must_use]
-    pub fn coarsened(self, fine: &Cut<'_>, coarse: &Cut<'_>, links: &[Link]) -> Option<LeafCoefficients> {
+    pub fn coarsened(&self, fine: &Cut<'_>, coarse: &Cut<'_>, links: &[Link]) -> Option<LeafCoefficients> {
         if self.closed || !self.is_complete() || self.scale.len() != links.len() {
             return None;
         }
@@ -261,7 +285,7 @@ impl LeafCoefficients {
             Precision::Single => Stored::Single(means_stored(unknowns, &start, &mean, |x| x)),
             Precision::Half => Stored::Half(means_stored(unknowns, &start, &mean, encode)),
         };
-        // The finer chains are done with; the rest of `self` is read below.
+        // The rest of `self` is read below.
         let LeafCoefficients {
             sorted,
             range,
@@ -272,8 +296,8 @@ impl LeafCoefficients {
             shared: fine_shared,
             ..
         } = self;
-        let chain = Chain { h, links, sorted: &sorted, range: &range, precision };
-        let (inside_start, inside) = inside_links(h, unknowns, &sorted, &range, links);
+        let chain = Chain { h, links, sorted, range, precision };
+        let (inside_start, inside) = inside_links(h, unknowns, sorted, range, links);
         let mut receiver_total = vec![0.0; links.len()];
         for (i, w) in start.windows(2).enumerate() {
             let inside = &inside[inside_start[i] as usize..inside_start[i + 1] as usize];
@@ -335,15 +359,16 @@ impl LeafCoefficients {
         }
         let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
         Some(LeafCoefficients {
-            sorted,
-            range,
+            sorted: sorted.clone(),
+            range: range.clone(),
             start,
             coef,
+            reused: 0,
             chain_entries,
             inside_start,
             inside,
             scale,
-            transfer,
+            transfer: transfer.clone(),
             value,
             weight_leaf,
             weight,
@@ -469,6 +494,13 @@ impl LeafCoefficients {
     #[must_use]
     pub fn stored_unknowns(&self) -> usize {
         self.start.len() - 1
+    }
+
+    /// Chain coefficients taken from an earlier level's ([`LeafCoefficients::for_cut_reusing`])
+    /// instead of computed.
+    #[must_use]
+    pub fn reused_entries(&self) -> usize {
+        self.reused
     }
 
     /// The share of the chain coefficients computed again at every application (0 when all are

@@ -49,10 +49,12 @@ mod chain;
 mod coefficients;
 mod operator;
 mod precision;
+mod reuse;
 mod weights;
 
 pub use operator::{LeafOperator, leaf_operator_entries};
 pub use precision::{HALF_MIN_TARGET, HALF_ROUNDING, Precision};
+pub use reuse::ChainReuse;
 
 use crate::hierarchy::ElementId;
 use precision::Stored;
@@ -85,6 +87,8 @@ pub struct LeafCoefficients {
     /// Start of each stored unknown's chain coefficients in `coef` (length stored + 1).
     start: Vec<usize>,
     coef: Stored,
+    /// Chain coefficients taken from an earlier level's.
+    reused: usize,
     /// Chain coefficients of every unknown, stored or not.
     chain_entries: usize,
     /// Links received inside an unknown (below it, on a coarsened cut): `(link, coefficient)`
