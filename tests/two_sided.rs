@@ -581,6 +581,21 @@ fn a_sliver_of_shadow_between_the_points_of_a_leaf_is_seen() {
 /// default target error).
 const SLIVER_TOL: f64 = 5e-3;
 
+/// The canopy [`a_canopy_absorbs_what_an_independent_photon_tracer_finds`] traces: leaf count,
+/// side (m), half the plot's width (m) and seed of [`canopy_leaves`].
+const TRACED_CANOPY: (usize, f64, f64, u64) = (200, 0.15, 2.5, 11);
+
+/// [`TRACED_CANOPY`]'s leaves (ρ .10/.45, τ .05/.40, one face each) over the ground (ρ .10/.25)
+/// under the sun and the sky, written as `canopy.toml` and `leaves.obj` in a new folder.
+fn traced_canopy() -> tempfile::TempDir {
+    let (n, side, half, seed) = TRACED_CANOPY;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("leaves.obj"), canopy_obj(n, side, half, seed, false)).unwrap();
+    let leaf = "reflectance = [0.10, 0.45]\ntransmittance = [0.05, 0.40]";
+    std::fs::write(dir.path().join("canopy.toml"), canopy_scene(leaf, "[0.10, 0.25]", true)).unwrap();
+    dir
+}
+
 /// The solver against an independent photon tracer ([`photons`]): 200 transmitting leaves
 /// (ρ .10/.45, τ .05/.40, written as one face each) over a 10 × 10 m ground (ρ .10/.25), the sun
 /// and the uniform sky, at the default settings. The power absorbed by the leaves and by the
@@ -588,11 +603,8 @@ const SLIVER_TOL: f64 = 5e-3;
 /// below a fifth of that. (The solver's sky is 145 cells, the tracer's continuous.)
 #[test]
 fn a_canopy_absorbs_what_an_independent_photon_tracer_finds() {
-    let (n, side, half, seed) = (200, 0.15, 2.5, 11);
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("leaves.obj"), canopy_obj(n, side, half, seed, false)).unwrap();
-    let leaf = "reflectance = [0.10, 0.45]\ntransmittance = [0.05, 0.40]";
-    std::fs::write(dir.path().join("canopy.toml"), canopy_scene(leaf, "[0.10, 0.25]", true)).unwrap();
+    let (n, side, half, seed) = TRACED_CANOPY;
+    let dir = traced_canopy();
     let (stats, csv) = solve(dir.path(), "canopy.toml");
     let rows = rows(&csv);
     let leaves = canopy_leaves(n, side, half, seed);
@@ -727,11 +739,7 @@ fn crossing_leaves_meet_the_target_and_absorb_what_the_photon_tracer_finds() {
 #[test]
 fn reused_leaf_coefficients_give_the_same_solution_bit_for_bit() {
     use radiosity::pipeline::{self, Config};
-    let (n, side, half, seed) = (200, 0.15, 2.5, 11);
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("leaves.obj"), canopy_obj(n, side, half, seed, false)).unwrap();
-    let leaf = "reflectance = [0.10, 0.45]\ntransmittance = [0.05, 0.40]";
-    std::fs::write(dir.path().join("canopy.toml"), canopy_scene(leaf, "[0.10, 0.25]", true)).unwrap();
+    let dir = traced_canopy();
     // As `radiosity solve` reads a scene file of daylight on plain geometry.
     let (file, lighting) = radiosity::instancing::load_with_lighting(&dir.path().join("canopy.toml")).expect("the scene loads");
     let mut scene = radiosity::instancing::flatten(&file, &radiosity::instancing::FlattenOptions::default()).unwrap();
