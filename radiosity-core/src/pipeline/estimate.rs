@@ -111,7 +111,7 @@ pub(super) fn estimate_error(
             .and_then(|(fine_cut, c)| {
                 let coarse = c.coarsened(&fine_cut, &cut, links);
                 // The solution's own chain coefficients serve the next level's too.
-                if levels == 1 {
+                if levels == 1 && config.reuse_leaf_coefficients {
                     reuse = Some(c.into_reuse(&fine_cut, links));
                 }
                 coarse

@@ -123,7 +123,7 @@ pub fn run_with_points(
             links: state.links.len(),
             oracle_calls: state.stats.oracle_calls - level_start_calls,
             links_kept_unexamined: std::mem::take(&mut state.kept_unexamined) as usize,
-            leaf_coefficients_reused: std::mem::take(&mut state.leaf_entries_reused),
+            leaf_coefficients_reused: leaf.reused,
             change: est.change,
             error_estimate: est.estimate,
             time_s: t0.elapsed().as_secs_f64(),
@@ -303,8 +303,6 @@ struct State {
     /// The last level's leaf-resolution chain coefficients, for the next level's to take from
     /// where its leaves and links are the same.
     chain_reuse: Option<solve::ChainReuse>,
-    /// Chain coefficients taken from the level before, summed over levels.
-    leaf_entries_reused: usize,
     /// Levels whose leaf-resolution operator was over its budget.
     over_budget: Option<LeafOverBudget>,
     /// Per polygon, the last level's estimated error of its mean radiosity (empty without one).
@@ -331,7 +329,6 @@ impl State {
             iterations: 0,
             leaf_entries: 0,
             chain_reuse: None,
-            leaf_entries_reused: 0,
             over_budget: None,
             polygon_errors: Vec::new(),
             timings,

@@ -34,6 +34,8 @@ pub(super) struct LeafSolved {
     /// be made from them ([`solve::LeafCoefficients::coarsened`]: every unknown's stored, an
     /// open scene).
     pub(super) coefficients: Option<solve::LeafCoefficients>,
+    /// Chain coefficients taken from the level before's.
+    pub(super) reused: usize,
 }
 
 impl State {
@@ -63,21 +65,20 @@ impl State {
         let budget = config.max_memory_bytes.saturating_sub(h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK);
         let leaf_budget = config.leaf_operator_max_bytes.min(budget);
         // The level before's chain coefficients serve where leaves and links are the same.
-        let earlier = self.chain_reuse.take().filter(|_| config.reuse_leaf_coefficients);
-        let mut leaf = earlier.and_then(|earlier| {
-            build_leaf_coefficients(
-                h,
-                links,
-                config,
-                leaf_budget,
-                cx.services.closed,
-                cx.progress,
-                config.stream_leaf_operator,
-                Some(&earlier),
-                &mut self.timings.leaf_operator,
-            )
-        });
-        self.leaf_entries_reused += leaf.as_ref().map_or(0, solve::LeafCoefficients::reused_entries);
+        let earlier = self.chain_reuse.take();
+        let mut leaf = build_leaf_coefficients(
+            h,
+            links,
+            config,
+            leaf_budget,
+            cx.services.closed,
+            cx.progress,
+            config.stream_leaf_operator,
+            earlier.as_ref(),
+            &mut self.timings.leaf_operator,
+        );
+        drop(earlier);
+        let reused = leaf.as_ref().map_or(0, solve::LeafCoefficients::reused_entries);
         let (sol, more_iterations, _) = finish_solve(
             h,
             links,
@@ -112,7 +113,7 @@ impl State {
         let coefficients = leaf.filter(|c| config.estimate_error && !cx.services.closed && c.is_complete());
         self.iterations += more_iterations;
         self.timings.solve += t.elapsed().as_secs_f64();
-        LeafSolved { solution: sol, closure_changes, budget: leaf_budget, coefficients }
+        LeafSolved { solution: sol, closure_changes, budget: leaf_budget, coefficients, reused }
     }
 
     /// What the next level's (or importance round's) refinement reads of the level's solution

@@ -118,23 +118,24 @@ impl Chain<'_> {
         self.for_each_raw(leaf, |k, c| f(k, p.round(c)));
     }
 
-    /// [`Chain::fill`] taking from `earlier` (the coefficients of an earlier level of the same
-    /// hierarchy, stored as `old`) every coefficient of an unknown that was one then, on a link
-    /// received at the same element from the same source with the same visibility and form
-    /// factor: what [`Chain::raw`] depends on, so the value is the one it would compute again.
-    /// Returns how many were taken.
-    pub(super) fn fill_reusing<T: Copy + Send + Sync>(
+    /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets
+    /// relative to `coef`, length `unknowns.len() + 1`), each as `store` turns it, in parallel;
+    /// with `earlier` (the coefficients of an earlier level of the same hierarchy, `old` as they
+    /// were stored), every coefficient of an unknown that was one then, on a link received at the
+    /// same element from the same source with the same visibility and form factor, is taken from
+    /// there: that is all [`Chain::raw`] depends on, so the value is the one it would compute
+    /// again. Returns how many were taken.
+    pub(super) fn fill<T: Copy + Send + Sync>(
         &self,
         unknowns: &[ElementId],
         start: &[usize],
         coef: &mut [T],
         store: impl Fn(f32) -> T + Sync,
-        earlier: &ChainReuse,
-        old: &[T],
+        earlier: Option<(&ChainReuse, &[T])>,
     ) -> usize {
         let taken = std::sync::atomic::AtomicUsize::new(0);
         fill_each(unknowns, start, coef, |u, out| {
-            let Some(i) = earlier.unknown_of(u) else {
+            let Some((earlier, old, i)) = earlier.and_then(|(e, old)| Some((e, old, e.unknown_of(u)?))) else {
                 let mut j = 0;
                 self.for_each_raw(u, |_, c| {
                     out[j] = store(c);
@@ -169,18 +170,6 @@ impl Chain<'_> {
             taken.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
         });
         taken.into_inner()
-    }
-
-    /// Fills `coef` with the chain coefficients of `unknowns` (in order, `start` their offsets
-    /// relative to `coef`, length `unknowns.len() + 1`), each as `store` turns it, in parallel.
-    pub(super) fn fill<T: Send>(&self, unknowns: &[ElementId], start: &[usize], coef: &mut [T], store: impl Fn(f32) -> T + Sync) {
-        fill_each(unknowns, start, coef, |u, out| {
-            let mut j = 0;
-            self.for_each_raw(u, |_, c| {
-                out[j] = store(c);
-                j += 1;
-            });
-        });
     }
 }
 

@@ -66,23 +66,16 @@ impl LeafCoefficients {
             start.push(next);
         }
         let stored = start.len() - 1;
-        let mut reused = 0;
-        let coef = match precision {
+        let (coef, reused) = match precision {
             Precision::Single => {
                 let mut v = vec![0.0f32; start[stored]];
-                match earlier.map(|e| (e, &e.coef)) {
-                    Some((e, Stored::Single(old))) => reused = chain.fill_reusing(&unknowns[..stored], &start, &mut v, |c| c, e, old),
-                    _ => chain.fill(&unknowns[..stored], &start, &mut v, |c| c),
-                }
-                Stored::Single(v)
+                let reused = chain.fill(&unknowns[..stored], &start, &mut v, |c| c, earlier.and_then(ChainReuse::single));
+                (Stored::Single(v), reused)
             }
             Precision::Half => {
                 let mut v = vec![0u16; start[stored]];
-                match earlier.map(|e| (e, &e.coef)) {
-                    Some((e, Stored::Half(old))) => reused = chain.fill_reusing(&unknowns[..stored], &start, &mut v, encode, e, old),
-                    _ => chain.fill(&unknowns[..stored], &start, &mut v, encode),
-                }
-                Stored::Half(v)
+                let reused = chain.fill(&unknowns[..stored], &start, &mut v, encode, earlier.and_then(ChainReuse::half));
+                (Stored::Half(v), reused)
             }
         };
         let (inside_start, inside) = inside_links(h, unknowns, &sorted, &range, links);
@@ -108,7 +101,7 @@ impl LeafCoefficients {
             }
             buffer.clear();
             buffer.resize(batch_start[batch_start.len() - 1], 0.0f32);
-            chain.fill(&unknowns[first..last], &batch_start, &mut buffer, |c| precision.round(c));
+            chain.fill(&unknowns[first..last], &batch_start, &mut buffer, |c| precision.round(c), None);
             for i in first..last {
                 let b = &buffer[batch_start[i - first]..];
                 add_unknown(i, &|j| b[j]);

@@ -38,6 +38,22 @@ impl ChainReuse {
         self.index.get(e as usize).filter(|&&i| i != NONE).map(|&i| i as usize)
     }
 
+    /// The kept coefficients with themselves, where stored in `f32`.
+    pub(super) fn single(&self) -> Option<(&ChainReuse, &[f32])> {
+        match &self.coef {
+            Stored::Single(v) => Some((self, v)),
+            Stored::Half(_) => None,
+        }
+    }
+
+    /// The kept coefficients with themselves, where stored in 16-bit codes.
+    pub(super) fn half(&self) -> Option<(&ChainReuse, &[u16])> {
+        match &self.coef {
+            Stored::Half(v) => Some((self, v)),
+            Stored::Single(_) => None,
+        }
+    }
+
     /// Chain coefficients kept.
     #[must_use]
     pub fn entries(&self) -> usize {
