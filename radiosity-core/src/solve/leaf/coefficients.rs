@@ -160,7 +160,9 @@ impl LeafCoefficients {
             n_weights += entries;
         }
         chunk_ends.push(groups.len());
-        let (mut weight_leaf, mut weight) = (Vec::with_capacity(n_leaves), Vec::with_capacity(n_weights));
+        // A closed scene's closure rescales the weights in place, in `f32`.
+        let weight_precision = if closed { Precision::Single } else { precision };
+        let (mut weight_leaf, mut weight) = (Vec::with_capacity(n_leaves), Stored::with_capacity(weight_precision, n_weights));
         let mut shared = Vec::new();
         let mut chunk_start = 0;
         for &chunk_end in &chunk_ends {
@@ -179,12 +181,12 @@ impl LeafCoefficients {
                 weight_leaf.extend_from_slice(below.below(s));
                 for (k, w) in r.own {
                     let begin = weight.len() as u32;
-                    weight.extend(w.iter().map(|&x| x as f32));
+                    weight.extend_f64(&w);
                     value[k as usize] = SourceValue::Own(begin, weight.len() as u32, leaves as u32);
                 }
                 if let Some(w) = r.shared {
                     let begin = weight.len();
-                    weight.extend(w.iter().map(|&x| x as f32));
+                    weight.extend_f64(&w);
                     for &k in r.far.iter() {
                         value[k as usize] = SourceValue::Shared(shared.len() as u32);
                     }
@@ -212,6 +214,7 @@ impl LeafCoefficients {
             closure: (1.0, 1.0),
             closure_change: Vec::new(),
         };
+        c.normalise_weights();
         if closed {
             c.close(cut);
         }
@@ -299,13 +302,13 @@ impl LeafCoefficients {
         // Source side: each weight range summed over the coarse unknowns its leaves lie in.
         let coarse_below = LeavesBelow::new(coarse);
         let mut value = vec![SourceValue::Leaf(NONE); links.len()];
-        let (mut weight_leaf, mut weight, mut shared) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut weight_leaf, mut weight, mut shared) = (Vec::new(), Stored::with_capacity(fine_weight.precision(), 0), Vec::new());
         let mut leaves_of: std::collections::HashMap<usize, u32> = std::collections::HashMap::new();
         let mut shared_of: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
         // Appends the coarse weights of the range `lo..hi` (fine leaves from `leaves`) of source
         // `s`; returns the start of its coarse leaves in `weight_leaf`.
         let mut sums = Vec::new();
-        let mut aggregate = |s: ElementId, lo: usize, hi: usize, leaves: usize, weight: &mut Vec<f32>| -> Option<u32> {
+        let mut aggregate = |s: ElementId, lo: usize, hi: usize, leaves: usize, weight: &mut Stored| -> Option<u32> {
             let list = coarse_below.below(s);
             let at = *leaves_of.entry(leaves).or_insert_with(|| {
                 weight_leaf.extend_from_slice(list);
@@ -313,15 +316,25 @@ impl LeafCoefficients {
             });
             sums.clear();
             sums.resize(list.len(), 0.0);
-            let mut p = 0;
-            for (&y, &w) in fine_leaf[leaves..leaves + hi - lo].iter().zip(&fine_weight[lo..hi]) {
-                let u = unknowns[coarse.unknown_of(y)?];
+            let (mut p, mut found) = (0, true);
+            fine_weight.for_each_in(lo..hi, |j, w| {
+                let Some(i) = coarse.unknown_of(fine_leaf[leaves + j - lo]) else {
+                    found = false;
+                    return;
+                };
+                let u = unknowns[i];
                 while list.get(p).is_some_and(|&x| x != u) {
                     p += 1;
                 }
-                *sums.get_mut(p)? += f64::from(w);
+                match sums.get_mut(p) {
+                    Some(x) => *x += w,
+                    None => found = false,
+                }
+            });
+            if !found {
+                return None;
             }
-            weight.extend(sums.iter().map(|&x| x as f32));
+            weight.extend_f64(&sums);
             Some(at)
         };
         for (k, l) in links.iter().enumerate() {
@@ -351,7 +364,7 @@ impl LeafCoefficients {
             };
         }
         let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
-        Some(LeafCoefficients {
+        let mut c = LeafCoefficients {
             sorted: sorted.clone(),
             range: range.clone(),
             start,
@@ -369,7 +382,9 @@ impl LeafCoefficients {
             closed: false,
             closure: (1.0, 1.0),
             closure_change: Vec::new(),
-        })
+        };
+        c.normalise_weights();
+        Some(c)
     }
 
     /// The smallest and largest factor the closure applied to a source unknown's delivered light
@@ -416,20 +431,20 @@ impl LeafCoefficients {
                     (lo, hi, leaves)
                 }
             };
-            for (&y, &q) in self.weighted_leaves(lo, hi, leaves) {
-                add(y, transfer[k] * f64::from(q));
-            }
+            self.weight.for_each_in(lo..hi, |j, q| add(self.weight_leaf[leaves + j - lo], transfer[k] * q));
         }
         let factor: Vec<f64> = delivered.iter().map(|&d| if d > 0.0 { (1.0 / d).clamp(CLOSURE_MIN, CLOSURE_MAX) } else { 1.0 }).collect();
         let f = |y: ElementId| cut.unknown_of(y).map_or(1.0, |i| factor[i]);
         // Rescale the weights of each range by the factors, renormalise, and keep each range's
         // mean factor: a link's transfer scales by its range's mean factor.
+        // (A closed scene's weights are stored in `f32`, see `for_cut_reusing`.)
         let mut rescale = |lo: usize, hi: usize, leaves: usize| -> f64 {
+            let Stored::Single(weight) = &mut self.weight else { return 1.0 };
             let scaled: Vec<f64> =
-                self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi]).map(|(&y, &w)| f64::from(w) * f(y)).collect();
+                self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&weight[lo..hi]).map(|(&y, &w)| f64::from(w) * f(y)).collect();
             let sum: f64 = scaled.iter().sum();
             let norm = if sum > 0.0 { sum } else { 1.0 };
-            for (w, x) in self.weight[lo..hi].iter_mut().zip(&scaled) {
+            for (w, x) in weight[lo..hi].iter_mut().zip(&scaled) {
                 *w = (x / norm) as f32;
             }
             sum
@@ -522,14 +537,29 @@ impl LeafCoefficients {
             + self.transfer.len() * size_of::<f64>()
             + self.value.len() * size_of::<SourceValue>()
             + self.weight_leaf.len() * size_of::<ElementId>()
-            + self.weight.len() * size_of::<f32>()
+            + self.weight.len() * self.weight.precision().bytes()
             + self.shared.len() * size_of::<(ElementId, usize, usize, usize)>()
     }
 
-    /// The leaves and weights of the range `lo..hi` of `weight`, whose source's leaves start at
-    /// `leaves` in `weight_leaf`.
-    fn weighted_leaves(&self, lo: usize, hi: usize, leaves: usize) -> impl Iterator<Item = (&ElementId, &f32)> {
-        self.weight_leaf[leaves..leaves + hi - lo].iter().zip(&self.weight[lo..hi])
+    /// Weights stored in [`Precision::Half`] are rounded each by up to [`super::HALF_ROUNDING`],
+    /// so a range no longer sums to 1: each link's receiver-side scale is divided by its range's
+    /// sum as applied, and the light a link sends is its transfer again, exactly. (`f32` weights
+    /// sum to 1 within 1e-7 and are left as they are.)
+    fn normalise_weights(&mut self) {
+        if self.weight.precision() != Precision::Half {
+            return;
+        }
+        let shared: Vec<f64> = self.shared.iter().map(|&(_, lo, hi, _)| self.weight.sum(lo..hi)).collect();
+        for (s, v) in self.scale.iter_mut().zip(&self.value) {
+            let sum = match *v {
+                SourceValue::Leaf(_) => continue,
+                SourceValue::Own(lo, hi, _) => self.weight.sum(lo as usize..hi as usize),
+                SourceValue::Shared(i) => shared[i as usize],
+            };
+            if sum > 0.0 {
+                *s /= sum;
+            }
+        }
     }
 
     /// The radiosity each link sends (see the module docs), for leaf radiosity read from `b` (per
@@ -537,12 +567,12 @@ impl LeafCoefficients {
     pub(super) fn link_values(&self, b: &[[f64; 3]]) -> Vec<[f64; 3]> {
         let weighted = |lo: usize, hi: usize, leaves: usize| {
             let mut acc = [0.0; 3];
-            for (&y, &w) in self.weighted_leaves(lo, hi, leaves) {
-                let (by, w) = (b[y as usize], f64::from(w));
+            self.weight.for_each_in(lo..hi, |j, w| {
+                let by = b[self.weight_leaf[leaves + j - lo] as usize];
                 for c in 0..3 {
                     acc[c] += w * by[c];
                 }
-            }
+            });
             acc
         };
         let shared: Vec<[f64; 3]> = self.shared.par_iter().map(|&(_, lo, hi, leaves)| weighted(lo, hi, leaves)).collect();

@@ -83,7 +83,7 @@ pub(super) fn decode(code: u16) -> f32 {
     table[usize::from(code)]
 }
 
-/// Stored chain coefficients, in either [`Precision`].
+/// Stored chain coefficients or source weights, in either [`Precision`].
 #[derive(Clone, Debug)]
 pub(super) enum Stored {
     Single(Vec<f32>),
@@ -91,6 +91,39 @@ pub(super) enum Stored {
 }
 
 impl Stored {
+    /// Empty, in `precision`, with room for `capacity` values.
+    pub(super) fn with_capacity(precision: Precision, capacity: usize) -> Stored {
+        match precision {
+            Precision::Single => Stored::Single(Vec::with_capacity(capacity)),
+            Precision::Half => Stored::Half(Vec::with_capacity(capacity)),
+        }
+    }
+
+    /// Appends `values` (non-negative), rounded to the precision.
+    pub(super) fn extend_f64(&mut self, values: &[f64]) {
+        match self {
+            Stored::Single(v) => v.extend(values.iter().map(|&x| x as f32)),
+            Stored::Half(v) => v.extend(values.iter().map(|&x| encode(x as f32))),
+        }
+    }
+
+    /// Calls `f(j, value)` for each stored value `j` of `range`, in order.
+    #[inline]
+    pub(super) fn for_each_in(&self, range: std::ops::Range<usize>, mut f: impl FnMut(usize, f64)) {
+        let lo = range.start;
+        match self {
+            Stored::Single(v) => v[range].iter().enumerate().for_each(|(i, &x)| f(lo + i, f64::from(x))),
+            Stored::Half(v) => v[range].iter().enumerate().for_each(|(i, &x)| f(lo + i, f64::from(decode(x)))),
+        }
+    }
+
+    /// The sum of the values of `range`, as they are applied.
+    pub(super) fn sum(&self, range: std::ops::Range<usize>) -> f64 {
+        let mut sum = 0.0;
+        self.for_each_in(range, |_, x| sum += x);
+        sum
+    }
+
     pub(super) fn len(&self) -> usize {
         match self {
             Stored::Single(v) => v.len(),
