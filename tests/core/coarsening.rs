@@ -59,7 +59,7 @@ fn coarser_cuts_from_the_finer_coefficients_match_coefficients_made_anew() {
             let cut = Cut::coarsened(h, levels);
             assert!(cut.len() < finer_cut.len(), "level {levels} merges pieces");
             let anew = LeafCoefficients::for_cut(&cut, links, false, usize::MAX, precision);
-            let derived = finer.coarsened(&finer_cut, &cut, links).expect("an open scene, every coefficient stored");
+            let derived = finer.coarsened(&finer_cut, &cut, links, false).0.expect("an open scene, every coefficient stored");
             assert_eq!(derived.chain_entries(), anew.chain_entries(), "the same chains");
             let a = coarse_means(Cut::coarsened(h, levels), links, &anew, initial);
             let d = coarse_means(Cut::coarsened(h, levels), links, &derived, initial);
@@ -86,7 +86,9 @@ fn a_closed_scene_builds_its_coarser_coefficients_anew() {
     let solved = solve(&scene, 0.05, 1e-3);
     let h = &solved.hierarchy;
     let fine = LeafCoefficients::for_cut(&Cut::leaves(h), &solved.links, true, usize::MAX, Precision::Single);
-    assert!(fine.coarsened(&Cut::leaves(h), &Cut::coarsened(h, 1), &solved.links).is_none());
+    let (coarse, kept) = fine.coarsened(&Cut::leaves(h), &Cut::coarsened(h, 1), &solved.links, true);
+    assert!(coarse.is_none());
+    assert!(kept.is_some(), "the chain coefficients are kept all the same");
 }
 
 /// Source weights stored in 16 bits (`Precision::Half`, each rounded by up to

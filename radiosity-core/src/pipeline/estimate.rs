@@ -109,10 +109,10 @@ pub(super) fn estimate_error(
         let coefficients = finer
             .take()
             .and_then(|(fine_cut, c)| {
-                let coarse = c.coarsened(&fine_cut, &cut, links);
                 // The solution's own chain coefficients serve the next level's too.
-                if levels == 1 && config.reuse_leaf_coefficients {
-                    reuse = Some(c.into_reuse(&fine_cut, links));
+                let (coarse, kept) = c.coarsened(&fine_cut, &cut, links, levels == 1 && config.reuse_leaf_coefficients);
+                if kept.is_some() {
+                    reuse = kept;
                 }
                 coarse
             })

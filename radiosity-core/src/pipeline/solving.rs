@@ -65,7 +65,6 @@ impl State {
         let budget = config.max_memory_bytes.saturating_sub(h.len() * refine::BYTES_PER_ELEMENT + links.len() * refine::BYTES_PER_LINK);
         let leaf_budget = config.leaf_operator_max_bytes.min(budget);
         // The level before's chain coefficients serve where leaves and links are the same.
-        let earlier = self.chain_reuse.take();
         let mut leaf = build_leaf_coefficients(
             h,
             links,
@@ -74,10 +73,9 @@ impl State {
             cx.services.closed,
             cx.progress,
             config.stream_leaf_operator,
-            earlier.as_ref(),
+            self.chain_reuse.take(),
             &mut self.timings.leaf_operator,
         );
-        drop(earlier);
         let reused = leaf.as_ref().map_or(0, solve::LeafCoefficients::reused_entries);
         let (sol, more_iterations, _) = finish_solve(
             h,
@@ -165,7 +163,7 @@ fn build_leaf_coefficients(
     closed: bool,
     progress: &dyn Fn(Progress),
     stream: bool,
-    earlier: Option<&solve::ChainReuse>,
+    earlier: Option<solve::ChainReuse>,
     built_s: &mut f64,
 ) -> Option<solve::LeafCoefficients> {
     let precision = solve::Precision::for_target(config.target_error);

@@ -39,6 +39,7 @@ impl LeafCoefficients {
     /// [`LeafCoefficients::for_cut`] taking from `earlier` (an earlier level's, of the same run)
     /// the chain coefficients it holds of the same unknown on the same link: the same values,
     /// bit for bit, without their form factors ([`LeafCoefficients::reused_entries`] counts them).
+    /// `earlier` is dropped as soon as the chain coefficients are made, before the source weights.
     #[must_use]
     pub fn for_cut_reusing(
         cut: &Cut<'_>,
@@ -46,7 +47,7 @@ impl LeafCoefficients {
         closed: bool,
         max_bytes: usize,
         precision: Precision,
-        earlier: Option<&ChainReuse>,
+        earlier: Option<ChainReuse>,
     ) -> LeafCoefficients {
         let h = cut.hierarchy();
         let LinksByReceiver { sorted, range, .. } = LinksByReceiver::new(h, links);
@@ -69,15 +70,17 @@ impl LeafCoefficients {
         let (coef, reused) = match precision {
             Precision::Single => {
                 let mut v = vec![0.0f32; start[stored]];
-                let reused = chain.fill(&unknowns[..stored], &start, &mut v, |c| c, earlier.and_then(ChainReuse::single));
+                let reused = chain.fill(&unknowns[..stored], &start, &mut v, |c| c, earlier.as_ref().and_then(ChainReuse::single));
                 (Stored::Single(v), reused)
             }
             Precision::Half => {
                 let mut v = vec![0u16; start[stored]];
-                let reused = chain.fill(&unknowns[..stored], &start, &mut v, encode, earlier.and_then(ChainReuse::half));
+                let reused = chain.fill(&unknowns[..stored], &start, &mut v, encode, earlier.as_ref().and_then(ChainReuse::half));
                 (Stored::Half(v), reused)
             }
         };
+        // The earlier level's coefficients go before the source weights are made.
+        drop(earlier);
         let (inside_start, inside) = inside_links(h, unknowns, &sorted, &range, links);
         // The receiver side's total per link, `Σ_unknowns A F V`, summed in cut order (unstored
         // unknowns' coefficients computed a batch at a time).
@@ -235,33 +238,57 @@ impl LeafCoefficients {
     /// `None` where `self` does not hold every unknown's chain coefficients, or in a closed scene
     /// (the closure has rescaled its weights to `fine`'s unknowns): there
     /// [`LeafCoefficients::for_cut`] builds them anew.
+    ///
+    /// `self` is consumed: its source side goes as soon as the coarse one is made from it, before
+    /// the coarse chain coefficients are (on the 3,200-leaf canopy the fine and the coarse
+    /// coefficients held together were the run's heap peak). With `keep_chain`, what is left of
+    /// it comes back as the next level's [`ChainReuse`] ([`LeafCoefficients::into_reuse`]).
     #[must_use]
-    pub fn coarsened(&self, fine: &Cut<'_>, coarse: &Cut<'_>, links: &[Link]) -> Option<LeafCoefficients> {
+    pub fn coarsened(
+        mut self,
+        fine: &Cut<'_>,
+        coarse: &Cut<'_>,
+        links: &[Link],
+        keep_chain: bool,
+    ) -> (Option<LeafCoefficients>, Option<ChainReuse>) {
+        let reuse = |c: LeafCoefficients| keep_chain.then(|| c.into_reuse(fine, links));
         if self.closed || !self.is_complete() || self.scale.len() != links.len() {
-            return None;
+            return (None, reuse(self));
         }
         let h = coarse.hierarchy();
         let precision = self.precision();
-        let chain = Chain { h, links, sorted: &self.sorted, range: &self.range, precision };
         let unknowns = coarse.elements();
-        let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
-        let mut start = Vec::with_capacity(unknowns.len() + 1);
-        start.push(0);
-        for &len in &lens {
-            start.push(start[start.len() - 1] + len);
-        }
-        let chain_entries = start[start.len() - 1];
-        // Every coarse unknown has finer ones below it, whose chains end with its own.
-        let fine_below = LeavesBelow::new(fine);
-        let chains_end_alike = unknowns.iter().zip(&lens).all(|(&u, &n)| {
-            let below = fine_below.below(u);
-            !below.is_empty() && below.iter().all(|&c| fine.unknown_of(c).is_some_and(|f| self.start[f + 1] - self.start[f] >= n))
-        });
-        if !chains_end_alike {
-            return None;
-        }
+        let (start, chain_entries) = {
+            let chain = Chain { h, links, sorted: &self.sorted, range: &self.range, precision };
+            let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
+            // Every coarse unknown has finer ones below it, whose chains end with its own.
+            let fine_below = LeavesBelow::new(fine);
+            let chains_end_alike = unknowns.iter().zip(&lens).all(|(&u, &n)| {
+                let below = fine_below.below(u);
+                !below.is_empty() && below.iter().all(|&c| fine.unknown_of(c).is_some_and(|f| self.start[f + 1] - self.start[f] >= n))
+            });
+            if !chains_end_alike {
+                return (None, reuse(self));
+            }
+            let mut start = Vec::with_capacity(unknowns.len() + 1);
+            start.push(0);
+            for &len in &lens {
+                start.push(start[start.len() - 1] + len);
+            }
+            let chain_entries = start[start.len() - 1];
+            (start, chain_entries)
+        };
+        // The source side first: each weight range summed over the coarse unknowns its leaves
+        // lie in. Then the fine weights go.
+        let sources = self.coarse_sources(coarse, links);
+        self.weight = Stored::with_capacity(self.weight.precision(), 0);
+        self.weight_leaf = Vec::new();
+        self.shared = Vec::new();
+        self.value = Vec::new();
+        let Some((value, weight_leaf, weight, shared)) = sources else { return (None, reuse(self)) };
         // A coarse unknown's coefficients: the area-weighted means of the finer unknowns' on the
         // same links, the last `out.len()` of each finer chain.
+        let fine_below = LeavesBelow::new(fine);
         let mean = |u: ElementId, out: &mut [f64]| {
             let n = out.len();
             let mut area = 0.0;
@@ -281,28 +308,66 @@ impl LeafCoefficients {
             Precision::Single => Stored::Single(means_stored(unknowns, &start, &mean, |x| x)),
             Precision::Half => Stored::Half(means_stored(unknowns, &start, &mean, encode)),
         };
-        // The rest of `self` is read below.
-        let LeafCoefficients {
-            sorted,
-            range,
-            transfer,
-            value: fine_value,
-            weight_leaf: fine_leaf,
-            weight: fine_weight,
-            shared: fine_shared,
-            ..
-        } = self;
-        let chain = Chain { h, links, sorted, range, precision };
-        let (inside_start, inside) = inside_links(h, unknowns, sorted, range, links);
+        let chain = Chain { h, links, sorted: &self.sorted, range: &self.range, precision };
+        let (inside_start, inside) = inside_links(h, unknowns, &self.sorted, &self.range, links);
         let mut receiver_total = vec![0.0; links.len()];
         for (i, w) in start.windows(2).enumerate() {
             let inside = &inside[inside_start[i] as usize..inside_start[i + 1] as usize];
             add_receiver_totals(&mut receiver_total, &chain, unknowns[i], inside, &|j| coef.get(w[0] + j));
         }
-        // Source side: each weight range summed over the coarse unknowns its leaves lie in.
+        let scale: Vec<f64> = self.transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
+        let mut c = LeafCoefficients {
+            sorted: self.sorted.clone(),
+            range: self.range.clone(),
+            start,
+            coef,
+            reused: 0,
+            chain_entries,
+            inside_start,
+            inside,
+            scale,
+            transfer: self.transfer.clone(),
+            value,
+            weight_leaf,
+            weight,
+            shared,
+            closed: false,
+            closure: (1.0, 1.0),
+            closure_change: Vec::new(),
+        };
+        c.normalise_weights();
+        (Some(c), reuse(self))
+    }
+
+    /// The source side of `self`'s links on `coarse`: each link's [`SourceValue`], the coarse
+    /// weights (each range of `self`'s summed over the coarse unknowns its leaves lie in) and
+    /// their leaves, and the shared ranges. `None` where a weighted leaf lies on no coarse unknown.
+    #[expect(clippy::type_complexity, reason = "the four parts of the source side, taken apart at once by the one caller")]
+    fn coarse_sources(
+        &self,
+        coarse: &Cut<'_>,
+        links: &[Link],
+    ) -> Option<(Vec<SourceValue>, Vec<ElementId>, Stored, Vec<(ElementId, usize, usize, usize)>)> {
+        let unknowns = coarse.elements();
         let coarse_below = LeavesBelow::new(coarse);
+        let (fine_leaf, fine_weight) = (&self.weight_leaf, &self.weight);
         let mut value = vec![SourceValue::Leaf(NONE); links.len()];
-        let (mut weight_leaf, mut weight, mut shared) = (Vec::new(), Stored::with_capacity(fine_weight.precision(), 0), Vec::new());
+        // Made at their size: grown by doubling, they were held up to twice over.
+        let mut entries = 0;
+        let mut counted = vec![false; self.shared.len()];
+        for (k, l) in links.iter().enumerate() {
+            match self.value[k] {
+                _ if coarse.unknown_of(l.source).is_some() => {}
+                SourceValue::Leaf(_) => {}
+                SourceValue::Own(..) => entries += coarse_below.below(l.source).len(),
+                SourceValue::Shared(i) => {
+                    if !std::mem::replace(&mut counted[i as usize], true) {
+                        entries += coarse_below.below(self.shared[i as usize].0).len();
+                    }
+                }
+            }
+        }
+        let (mut weight_leaf, mut weight, mut shared) = (Vec::new(), Stored::with_capacity(fine_weight.precision(), entries), Vec::new());
         let mut leaves_of: std::collections::HashMap<usize, u32> = std::collections::HashMap::new();
         let mut shared_of: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
         // Appends the coarse weights of the range `lo..hi` (fine leaves from `leaves`) of source
@@ -342,7 +407,7 @@ impl LeafCoefficients {
                 value[k] = SourceValue::Leaf(unknowns[i]);
                 continue;
             }
-            value[k] = match fine_value[k] {
+            value[k] = match self.value[k] {
                 SourceValue::Leaf(e) => SourceValue::Leaf(e),
                 SourceValue::Own(lo, hi, leaves) => {
                     let begin = weight.len() as u32;
@@ -353,7 +418,7 @@ impl LeafCoefficients {
                     if let Some(&j) = shared_of.get(&i) {
                         SourceValue::Shared(j)
                     } else {
-                        let (s, lo, hi, leaves) = fine_shared[i as usize];
+                        let (s, lo, hi, leaves) = self.shared[i as usize];
                         let begin = weight.len();
                         let at = aggregate(s, lo, hi, leaves, &mut weight)?;
                         shared.push((s, begin, weight.len(), at as usize));
@@ -363,28 +428,7 @@ impl LeafCoefficients {
                 }
             };
         }
-        let scale: Vec<f64> = transfer.iter().zip(&receiver_total).map(|(&t, &r)| if r > 0.0 { t / r } else { 1.0 }).collect();
-        let mut c = LeafCoefficients {
-            sorted: sorted.clone(),
-            range: range.clone(),
-            start,
-            coef,
-            reused: 0,
-            chain_entries,
-            inside_start,
-            inside,
-            scale,
-            transfer: transfer.clone(),
-            value,
-            weight_leaf,
-            weight,
-            shared,
-            closed: false,
-            closure: (1.0, 1.0),
-            closure_change: Vec::new(),
-        };
-        c.normalise_weights();
-        Some(c)
+        Some((value, weight_leaf, weight, shared))
     }
 
     /// The smallest and largest factor the closure applied to a source unknown's delivered light
