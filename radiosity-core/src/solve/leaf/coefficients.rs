@@ -258,11 +258,11 @@ impl LeafCoefficients {
         let h = coarse.hierarchy();
         let precision = self.precision();
         let unknowns = coarse.elements();
+        let fine_below = LeavesBelow::new(fine);
         let (start, chain_entries) = {
             let chain = Chain { h, links, sorted: &self.sorted, range: &self.range, precision };
             let lens: Vec<usize> = unknowns.par_iter().map(|&u| chain.len(u)).collect();
             // Every coarse unknown has finer ones below it, whose chains end with its own.
-            let fine_below = LeavesBelow::new(fine);
             let chains_end_alike = unknowns.iter().zip(&lens).all(|(&u, &n)| {
                 let below = fine_below.below(u);
                 !below.is_empty() && below.iter().all(|&c| fine.unknown_of(c).is_some_and(|f| self.start[f + 1] - self.start[f] >= n))
@@ -288,7 +288,6 @@ impl LeafCoefficients {
         let Some((value, weight_leaf, weight, shared)) = sources else { return (None, reuse(self)) };
         // A coarse unknown's coefficients: the area-weighted means of the finer unknowns' on the
         // same links, the last `out.len()` of each finer chain.
-        let fine_below = LeavesBelow::new(fine);
         let mean = |u: ElementId, out: &mut [f64]| {
             let n = out.len();
             let mut area = 0.0;

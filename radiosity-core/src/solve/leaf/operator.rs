@@ -4,7 +4,7 @@
 
 use super::LeafCoefficients;
 use super::chain::{Chain, LeavesBelow};
-use super::precision::{Stored, decode};
+use super::precision::{Stored, decode_table};
 use super::weights::own_weights;
 use crate::hierarchy::{Hierarchy, NONE};
 use crate::refine::Link;
@@ -91,6 +91,7 @@ impl<'a> LeafOperator<'a> {
         let chain = Chain { h: self.cut.hierarchy(), links: self.links, sorted: &l.sorted, range: &l.range, precision: l.coef.precision() };
         let stored = l.stored_unknowns();
         let unknowns = self.cut.elements();
+        let table = decode_table();
         (0..self.cut.len())
             .into_par_iter()
             .map(|i| {
@@ -110,7 +111,7 @@ impl<'a> LeafOperator<'a> {
                             j += 1;
                         }),
                         Stored::Half(v) => chain.for_each_link(unknowns[i], |k| {
-                            add(k, decode(v[j]));
+                            add(k, table[usize::from(v[j])]);
                             j += 1;
                         }),
                     }

@@ -74,13 +74,18 @@ pub(super) fn encode(c: f32) -> u16 {
 
 /// The value of a [`Precision::Half`] code.
 pub(super) fn decode(code: u16) -> f32 {
+    decode_table()[usize::from(code)]
+}
+
+/// Every [`Precision::Half`] code's value, indexed by the code: loops over many codes (the leaf
+/// operator's gather) take it once instead of through [`decode`] per value.
+pub(super) fn decode_table() -> &'static [f32] {
     static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
-    let table = TABLE.get_or_init(|| {
+    TABLE.get_or_init(|| {
         (0..=u16::MAX)
             .map(|code| if code == 0 { 0.0 } else { (CODE_LOG2_MIN + f64::from(code - 1) * (CODE_LOG2_SPAN / CODE_STEPS)).exp2() as f32 })
             .collect()
-    });
-    table[usize::from(code)]
+    })
 }
 
 /// Stored chain coefficients or source weights, in either [`Precision`].
@@ -113,7 +118,10 @@ impl Stored {
         let lo = range.start;
         match self {
             Stored::Single(v) => v[range].iter().enumerate().for_each(|(i, &x)| f(lo + i, f64::from(x))),
-            Stored::Half(v) => v[range].iter().enumerate().for_each(|(i, &x)| f(lo + i, f64::from(decode(x)))),
+            Stored::Half(v) => {
+                let table = decode_table();
+                v[range].iter().enumerate().for_each(|(i, &x)| f(lo + i, f64::from(table[usize::from(x)])));
+            }
         }
     }
 
