@@ -19,6 +19,11 @@ const PACK_TOL: f64 = 1e-9;
 const CROSS_PACK_TOL: f64 = BALANCE_TOL;
 /// Exact cases (an unobstructed plane) agree to rounding.
 const EXACT_TOL: f64 = 1e-9;
+/// A luminaire's light on a room's surfaces, integrated by the leaves' quadrature (an isotropic
+/// lamp in a black room: measured 1e-7 of the closed form).
+const LAMP_ONTO_TOL: f64 = 1e-4;
+/// A luminaire's illuminance at a calculation point, against the inverse-square law.
+const LAMP_POINT_TOL: f64 = 1e-6;
 
 fn run_cli(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_radiosity")).args(args).current_dir(dir).output().expect("the binary runs")
@@ -298,4 +303,128 @@ fn a_small_shadow_on_a_large_ground_is_exact_at_the_default_settings() {
         "ground {ground} expected {expected} (unshadowed {})",
         800.0 * along([0.0, 0.0, 1.0])
     );
+}
+
+/// A 4 × 4 × 3 m room whose ceiling has a 1 × 1 m opening in its middle (x, y 1.5..2.5), all of
+/// reflectance `rho`, lit by a uniform sky of 1000 lx through the opening and an isotropic
+/// 10,000 lm lamp at (1, 1, 2.5) (the shipped IES file): daylight and a luminaire in one scene.
+fn skylit_room_with_a_lamp(rho: f64, lamp: bool, sky: bool) -> String {
+    let mut s = format!("units = \"photometric\"\n[[material]]\nname = \"room\"\nreflectance = {rho}\n");
+    for v in [
+        "[[0,0,0],[4,0,0],[4,4,0],[0,4,0]]",
+        "[[0,0,0],[0,0,3],[4,0,3],[4,0,0]]",
+        "[[0,4,0],[4,4,0],[4,4,3],[0,4,3]]",
+        "[[0,0,0],[0,4,0],[0,4,3],[0,0,3]]",
+        "[[4,0,0],[4,0,3],[4,4,3],[4,4,0]]",
+        "[[0,0,3],[0,1.5,3],[4,1.5,3],[4,0,3]]",
+        "[[0,2.5,3],[0,4,3],[4,4,3],[4,2.5,3]]",
+        "[[0,1.5,3],[0,2.5,3],[1.5,2.5,3],[1.5,1.5,3]]",
+        "[[2.5,1.5,3],[2.5,2.5,3],[4,2.5,3],[4,1.5,3]]",
+    ] {
+        s += &format!("[[polygon]]\nmaterial = \"room\"\nvertices = {v}\n");
+    }
+    if lamp {
+        s += "[[luminaire]]\nies = \"isotropic_10000lm.ies\"\nname = \"lamp\"\nposition = [1.0, 1.0, 2.5]\n";
+    }
+    if sky {
+        s += "[sky]\nmodel = \"uniform\"\ndiffuse_horizontal = 1000\n";
+    }
+    s
+}
+
+/// Lambert's form factor from a point facing +z to the parallel rectangle [x0, x1] × [y0, y1] at
+/// height `h` above it (corner rectangles added with signs).
+fn point_to_rectangle(p: [f64; 2], x: [f64; 2], y: [f64; 2], h: f64) -> f64 {
+    let corner = |a: f64, b: f64| {
+        let (a, b) = (a / h, b / h);
+        let (ra, rb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
+        (a / ra * (b / ra).atan() + b / rb * (a / rb).atan()) / std::f64::consts::TAU
+    };
+    let mut f = 0.0;
+    for (xi, sx) in [(x[1], 1.0), (x[0], -1.0)] {
+        for (yi, sy) in [(y[1], 1.0), (y[0], -1.0)] {
+            let (dx, dy) = (xi - p[0], yi - p[1]);
+            f += sx * sy * dx.signum() * dy.signum() * corner(dx.abs(), dy.abs());
+        }
+    }
+    f
+}
+
+/// Irradiance and its estimated error at the points of `points.csv` in `out`.
+fn points_read(out: &Path) -> Vec<(f64, f64)> {
+    let (header, rows) = csv(&out.join("points.csv"));
+    let (h, err) = (column(&header, "h_photopic"), column(&header, "h_err"));
+    rows.iter().map(|r| (r[h].parse().unwrap(), r[err].parse().unwrap())).collect()
+}
+
+/// Issue 40 step 4: daylight and luminaires in one scene and one solve, each source's share
+/// reported. In the black room every number has a closed form: the lamp's light on the surfaces
+/// is its flux less what leaves through the opening, `Φ (1 − Ω/4π)` with Ω the opening's solid
+/// angle from the lamp; that remainder is the escaped light; a floor point gets `I cos θ / d²`
+/// from the lamp plus the sky's `E_h F(point → opening)`. The points are read in one solve with
+/// both sources and in two with one each: the same numbers (superposition), the lamp's part
+/// exact, the sky's within its estimated error. In the grey room the light interreflects and
+/// the balance still closes.
+#[test]
+fn daylight_and_a_luminaire_light_one_room_in_one_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let ies = Path::new(env!("CARGO_MANIFEST_DIR")).join("radiosity-core/data/luminaires/isotropic_10000lm.ies");
+    std::fs::copy(ies, dir.path().join("isotropic_10000lm.ies")).unwrap();
+    let floor: [[f64; 2]; 3] = [[2.0, 2.0], [1.0, 1.0], [3.5, 2.0]];
+    let points: String = floor.iter().enumerate().map(|(i, [x, y])| format!("p{i},{x},{y},0,0,0,1\n")).collect();
+    std::fs::write(dir.path().join("pts.csv"), format!("name,x,y,z,nx,ny,nz\n{points}")).unwrap();
+    let run = |name: &str, text: &str| {
+        std::fs::write(dir.path().join(format!("{name}.toml")), text).unwrap();
+        let out = run_cli(dir.path(), &["solve", &format!("{name}.toml"), "--points", "pts.csv", "--quiet", "--no-image", "--out", name]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join(name).join("stats.json")).unwrap()).unwrap();
+        (stats, points_read(&dir.path().join(name)))
+    };
+    let (both, at_both) = run("both", &skylit_room_with_a_lamp(0.0, true, true));
+    let (_, at_lamp) = run("lamp", &skylit_room_with_a_lamp(0.0, true, false));
+    let (sky_only, at_sky) = run("sky", &skylit_room_with_a_lamp(0.0, false, true));
+
+    // The lamp: what reaches the surfaces and what escapes through the opening, exactly.
+    let flux = 10_000.0;
+    // The opening seen from the lamp 0.5 m below it: x and y 0.5..1.5 m off its foot.
+    let corner = |x: f64, y: f64| (x * y / (0.5 * (x * x + y * y + 0.25f64).sqrt())).atan();
+    let solid_angle = corner(1.5, 1.5) - corner(0.5, 1.5) - corner(1.5, 0.5) + corner(0.5, 0.5);
+    let onto_exact = flux * (1.0 - solid_angle / (4.0 * std::f64::consts::PI));
+    let sources = both["sources"].as_array().expect("sources in stats.json");
+    let source = |name: &str| sources.iter().find(|s| s["name"] == name).unwrap_or_else(|| panic!("no source {name}: {sources:?}"));
+    let onto = |s: &serde_json::Value| s["onto_surfaces"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).sum::<f64>() / 3.0;
+    let (lamp, sky) = (source("lamp"), source("sky"));
+    assert_eq!((lamp["kind"].as_str(), sky["kind"].as_str(), sources.len()), (Some("luminaire"), Some("sky"), 2));
+    assert!((onto(lamp) / onto_exact - 1.0).abs() < LAMP_ONTO_TOL, "lamp onto the surfaces {} against {onto_exact}", onto(lamp));
+    // The sky's part is what the sky brings alone, and it is all the incident light.
+    let incident = both["power_incident"].as_f64().unwrap();
+    assert!((onto(sky) / incident - 1.0).abs() < EXACT_TOL, "sky {} against incident {incident}", onto(sky));
+    let shares = lamp["share"].as_f64().unwrap() + sky["share"].as_f64().unwrap();
+    assert!(
+        (shares - 1.0).abs() < EXACT_TOL && (lamp["share"].as_f64().unwrap() - onto(lamp) / (onto(lamp) + onto(sky))).abs() < EXACT_TOL
+    );
+    // Black: nothing is reflected, so what escapes is the lamp's light through the opening.
+    let escaped = both["power_escaped"].as_f64().unwrap();
+    assert!((escaped - (flux - onto_exact)).abs() < LAMP_ONTO_TOL * flux, "escaped {escaped} against {}", flux - onto_exact);
+    assert!((both["power_emitted"].as_f64().unwrap() - flux).abs() < 1e-6 * flux);
+    assert!((both["power_balance"].as_f64().unwrap() - 1.0).abs() < BALANCE_TOL, "{}", both["power_balance"]);
+    assert!(sky_only.get("sources").is_none(), "one kind of source: no shares");
+
+    // The points: one solve with both is the sum of one with each; the lamp's part is exact, the
+    // sky's within its estimate.
+    let intensity = flux / (4.0 * std::f64::consts::PI);
+    for (((p, b), l), s) in floor.iter().zip(&at_both).zip(&at_lamp).zip(&at_sky) {
+        assert!((b.0 - (l.0 + s.0)).abs() < 1e-9 * b.0, "{p:?}: both {} against {} + {}", b.0, l.0, s.0);
+        let d2 = (p[0] - 1.0).powi(2) + (p[1] - 1.0).powi(2) + 2.5 * 2.5;
+        let lamp_exact = intensity * 2.5 / d2.powf(1.5);
+        assert!((l.0 / lamp_exact - 1.0).abs() < LAMP_POINT_TOL, "{p:?}: lamp {} against {lamp_exact}", l.0);
+        let sky_exact = 1000.0 * point_to_rectangle(*p, [1.5, 2.5], [1.5, 2.5], 3.0);
+        eprintln!("{p:?}: lamp {:.4} (exact {lamp_exact:.4}), sky {:.4} ± {:.4} (exact {sky_exact:.4})", l.0, s.0, s.1);
+    }
+
+    // Grey: interreflected, and still balanced.
+    let (grey, _) = run("grey", &skylit_room_with_a_lamp(0.5, true, true));
+    assert!((grey["power_balance"].as_f64().unwrap() - 1.0).abs() < BALANCE_TOL, "{}", grey["power_balance"]);
+    assert_eq!(grey["sources"].as_array().map(Vec::len), Some(2));
 }

@@ -34,13 +34,15 @@
 //! shadows fall along a distant source's direction; `update.rs` computes the elements' direct
 //! light ([`update_direct`], [`deepen_direct`]) with `rule.rs`'s quadrature of one leaf; `errors.rs`
 //! holds each polygon's quadrature error and the splits it asks for ([`direct_polygon_errors`],
-//! [`direct_splits`]); `means.rs` the polygons' means and the flux received.
+//! [`direct_splits`]); `means.rs` the polygons' means and the flux received; `shares.rs` what each
+//! source brings to the surfaces ([`source_shares`]).
 
 mod errors;
 mod means;
 mod point;
 mod rule;
 mod shadows;
+mod shares;
 mod split;
 mod update;
 
@@ -50,6 +52,7 @@ pub use errors::{DIRECT_FLOOR_REL, direct_polygon_errors, direct_splits};
 pub use means::{flux_received, polygon_direct_means};
 pub use point::DirectLight;
 pub(crate) use shadows::ParallelShadows;
+pub use shares::{SourceKind, SourceShare, luminaires_onto_surfaces, source_shares};
 pub use split::prepare;
 pub use update::{deepen_direct, update_direct};
 

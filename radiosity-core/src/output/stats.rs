@@ -156,6 +156,11 @@ pub struct Stats {
     /// The luminaires (photometric scenes; absent without).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub luminaires: Vec<LuminaireStats>,
+    /// In a scene lit by daylight and luminaires together: what each source (every luminaire,
+    /// the sun, the sky) brings directly to the surfaces and its share of all of it
+    /// ([`crate::luminaire::source_shares`]); absent otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<crate::luminaire::SourceShare>,
     /// The figures of each calculation grid, by name, on the photopic value (`solve --grid` /
     /// `--work-plane`; absent without).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -237,6 +242,16 @@ pub fn channel_powers_and_losses(solved: &crate::pipeline::Solved) -> ([BandPowe
             out[c].lost_at_backs = outside.lost_at_backs[c];
         }
         lost_by_polygon = outside.lost_by_polygon;
+        if !solved.lights.luminaires.is_empty() {
+            // The leaves' direct light counted as incident holds the luminaires' too: what they
+            // bring to the surfaces is emitted (their flux), not incident, and the rest of their
+            // flux leaves the scene without touching a surface.
+            let onto = crate::luminaire::luminaires_onto_surfaces(h, &solved.lights.luminaires, Some(&solved.caster));
+            for c in 0..3 {
+                out[c].incident -= onto[c];
+                out[c].escaped += (lum - onto[c]).max(0.0);
+            }
+        }
     }
     for o in &mut out {
         o.emitted += lum;
@@ -407,8 +422,12 @@ impl Stats {
                     declared_lm: l.photometry.declared_lumens.map(|d| d * l.multiplier),
                 })
                 .collect(),
+            sources: Vec::new(),
             grids: None,
         };
+        if !solved.lights.luminaires.is_empty() && !solved.lights.distant.is_empty() {
+            stats.sources = crate::luminaire::source_shares(h, &solved.lights.luminaires, &solved.lights.distant, Some(&solved.caster));
+        }
         if !solved.lights.distant.is_empty() {
             let (per, lost_by_polygon) = channel_powers_and_losses(solved);
             stats.set_band_powers(&crate::output::csv::RGB, &per, true);

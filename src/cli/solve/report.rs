@@ -87,6 +87,10 @@ pub(super) fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
         let declared = l.declared_lm.map_or(String::new(), |d| format!(" (file declares {d:.1} lm)"));
         println!("luminaire {}: {:.1} lm{declared}", l.name, l.flux_lm);
     }
+    for source in &s.sources {
+        let onto = source.onto_surfaces.iter().sum::<f64>() / 3.0;
+        println!("source {}: {onto:.6e} {unit} onto the surfaces directly, {:.2}% of all sources'", source.name, 100.0 * source.share);
+    }
     for w in &s.solve_warnings {
         eprintln!("warning: {w}");
     }

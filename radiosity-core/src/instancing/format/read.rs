@@ -239,11 +239,6 @@ pub fn parse_with_lighting(text: &str, path: &Path, dir: &Path) -> Result<(Insta
         .map_err(|e| InstancingError::at(path, line, e.to_string()))?;
         luminaires.push(lum);
     }
-    if !luminaires.is_empty() && bands.has_daylight() {
-        let span = spec.sun.as_ref().map(Spanned::span).or_else(|| spec.sky.as_ref().map(Spanned::span));
-        let line = span.map_or(1, |s| line_of(s.start));
-        return Err(InstancingError::at(path, line, "luminaires and daylight in one scene are not supported"));
-    }
     if units == crate::photometry::Units::Photometric && bands.declared {
         return Err(InstancingError::at(path, 1, "`bands` are radiometric: leave out `units = \"photometric\"`"));
     }
