@@ -86,7 +86,7 @@ fn suns(zenith_deg: f64, azimuths: usize) -> Vec<DistantSource> {
     (0..azimuths)
         .map(|k| {
             let az = (k as f64 + 0.25) / azimuths as f64 * std::f64::consts::TAU;
-            DistantSource { toward: -site.direction(zenith_deg.to_radians(), az), irradiance: [1.0; 3], sharp: true }
+            DistantSource { toward: -site.direction(zenith_deg.to_radians(), az), irradiance: [1.0; 3], sharp: true, patch: None }
         })
         .collect()
 }

@@ -70,6 +70,6 @@ impl CieSky {
     pub(super) fn sources(self, cells: &[SkyCell], diffuse_horizontal: [f64; 3], site: &Site) -> Vec<DistantSource> {
         let vectors: Vec<[f64; 3]> =
             cells.iter().map(|c| light_vector(c, |zenith, azimuth| self.relative_luminance(zenith, azimuth))).collect();
-        scaled_sources(&vectors, diffuse_horizontal, site)
+        scaled_sources(cells, &vectors, diffuse_horizontal, site)
     }
 }

@@ -136,7 +136,7 @@ impl PerezSky {
         let k = self.coefficients();
         let vectors: Vec<[f64; 3]> =
             cells.iter().map(|c| light_vector(c, |zenith, azimuth| self.luminance_with(k, zenith, azimuth))).collect();
-        scaled_sources(&vectors, diffuse_horizontal, site)
+        scaled_sources(cells, &vectors, diffuse_horizontal, site)
     }
 }
 

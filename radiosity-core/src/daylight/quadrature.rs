@@ -40,17 +40,18 @@ pub(super) fn light_vector(cell: &SkyCell, luminance: impl Fn(f64, f64) -> f64) 
 }
 
 /// The cells of light vectors `vectors` as distant sources delivering `diffuse_horizontal` to an
-/// unobstructed horizontal plane (see [`super::sky`]).
-pub(super) fn scaled_sources(vectors: &[[f64; 3]], diffuse_horizontal: [f64; 3], site: &Site) -> Vec<DistantSource> {
+/// unobstructed horizontal plane (see [`super::sky`]), each with its patch of sky.
+pub(super) fn scaled_sources(cells: &[SkyCell], vectors: &[[f64; 3]], diffuse_horizontal: [f64; 3], site: &Site) -> Vec<DistantSource> {
     let total: f64 = vectors.iter().map(|v| v[2]).sum();
-    vectors
+    cells
         .iter()
-        .map(|v| {
+        .zip(vectors)
+        .map(|(cell, v)| {
             let magnitude = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
             let zenith = v[0].hypot(v[1]).atan2(v[2]);
             let azimuth = v[0].atan2(v[1]);
             let scale = magnitude / total;
-            DistantSource { toward: -site.direction(zenith, azimuth), irradiance: diffuse_horizontal.map(|e| e * scale), sharp: false }
+            super::sky::cell_source(cell, -site.direction(zenith, azimuth), diffuse_horizontal.map(|e| e * scale), site)
         })
         .collect()
 }

@@ -5,6 +5,7 @@ use super::cie_general::CieSky;
 use super::perez::PerezSky;
 use super::{DaylightError, DistantSource, Site, check_levels};
 use crate::geom::DVec3;
+use crate::light::SkyPatch;
 
 /// Radiance distribution of the sky over its hemisphere.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -121,9 +122,17 @@ pub fn sky(model: SkyModel, diffuse_horizontal: [f64; 3], n: u32, site: &Site) -
             let azimuth = c.phi_start + 0.5 * c.phi_width;
             let toward = -site.direction(zenith, azimuth);
             let scale = magnitude / total;
-            DistantSource { toward, irradiance: diffuse_horizontal.map(|e| e * scale), sharp: false }
+            cell_source(c, toward, diffuse_horizontal.map(|e| e * scale), site)
         })
         .collect())
+}
+
+/// Sky cell `cell` as a distant source whose light travels along `toward` with `irradiance` on a
+/// plane facing it, with its patch of sky.
+pub(super) fn cell_source(cell: &SkyCell, toward: DVec3, irradiance: [f64; 3], site: &Site) -> DistantSource {
+    let frame = [site.east(), site.north, site.up];
+    let patch = SkyPatch::new(frame, [cell.mu_low, cell.mu_high], [cell.phi_start, cell.phi_width], toward, irradiance);
+    DistantSource { toward, irradiance, sharp: false, patch: Some(patch) }
 }
 
 /// Cells of the hemisphere about a surface's normal through which [`power_leaving`](super::power_leaving) looks.

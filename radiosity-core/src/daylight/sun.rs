@@ -92,5 +92,5 @@ pub fn sun(toward: DVec3, direct_normal: [f64; 3], site: &Site) -> Result<Option
     }
     check_levels("direct_normal", &direct_normal)?;
     let toward = toward / len;
-    Ok((toward.dot(site.up) < 0.0).then_some(DistantSource { toward, irradiance: direct_normal, sharp: true }))
+    Ok((toward.dot(site.up) < 0.0).then_some(DistantSource { toward, irradiance: direct_normal, sharp: true, patch: None }))
 }

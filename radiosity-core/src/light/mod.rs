@@ -12,7 +12,7 @@
 pub mod distant;
 pub mod luminaire;
 
-pub use distant::DistantSource;
+pub use distant::{DistantSource, SkyPatch};
 pub use luminaire::{Luminaire, LuminaireError};
 
 /// Every light source of a scene besides its emitting polygons.

@@ -14,8 +14,8 @@ mod read;
 
 pub use gather::{
     AsSolveParts, LeafError, MAX_SHADOW_DEPTH, ON_SURFACE_REL_TOL, ORIGIN_OFFSET_REL, PointGather, PointsConfig, SAMPLE_INSET,
-    SAMPLE_SHIFT, SHADOW_DEPTH, SHADOW_EDGE_REL_ERROR, SKY_ERROR_FACTOR, SKY_PROBE_SPREAD, SKY_PROBES, SolveParts, UNIFORM_MAX_SUBTENSE,
-    gather,
+    SAMPLE_SHIFT, SHADOW_DEPTH, SHADOW_EDGE_REL_ERROR, SKY_ERROR_FACTOR, SKY_PATCH_ERROR_FACTOR, SKY_PATCH_PIECES, SKY_PATCH_PROBES,
+    SKY_PROBE_SPREAD, SKY_PROBES, SolveParts, UNIFORM_MAX_SUBTENSE, gather,
 };
 pub use grid::{Grid, GridError, GridSpec, GridSummary};
 pub use read::{PointsError, parse_points, read_points};
@@ -63,8 +63,8 @@ pub struct PointIrradiance {
     /// the solve has no error estimate to start from.
     pub h_err: [f64; 3],
     /// The part of [`PointIrradiance::h_err`] that comes from the sky's discretisation into
-    /// cells, each seen or not along the ray through its middle (W/m², per channel): what a finer
-    /// sky (more `directions`) lowers, and refinement does not.
+    /// cells, each sampled ray by ray where the point sees part of it (W/m², per channel): what a
+    /// finer sky (more `directions`) lowers, and refinement does not.
     pub sky_err: [f64; 3],
     /// Visibility rays cast for this point (0 where none were needed).
     pub rays: u64,

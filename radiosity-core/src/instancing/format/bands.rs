@@ -173,7 +173,7 @@ impl Bands {
     pub fn pack_distant(&self, k: usize) -> Vec<DistantSource> {
         let mut out = Vec::new();
         if let Some((toward, dni)) = &self.sun {
-            out.push(DistantSource { toward: *toward, irradiance: pick(dni, k), sharp: true });
+            out.push(DistantSource { toward: *toward, irradiance: pick(dni, k), sharp: true, patch: None });
         }
         if let Some((model, dhi, n)) = &self.sky {
             out.extend(daylight::sky(*model, pick(dhi, k), *n, &self.site).expect("checked when read"));

@@ -355,8 +355,8 @@ mod tests {
     #[test]
     fn unoccluded_polygon_gets_e_cos() {
         let p = Poly::quad(DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y);
-        let sun = DistantSource { toward: DVec3::new(0.6, 0.0, -0.8), irradiance: [100.0, 50.0, 10.0], sharp: true };
-        let below = DistantSource { toward: DVec3::Z, irradiance: [7.0; 3], sharp: false };
+        let sun = DistantSource { toward: DVec3::new(0.6, 0.0, -0.8), irradiance: [100.0, 50.0, 10.0], sharp: true, patch: None };
+        let below = DistantSource { toward: DVec3::Z, irradiance: [7.0; 3], sharp: false, patch: None };
         let (front, back) = polygon_irradiance(&p, true, 16, 3, &[sun, below], (1e-6, 10.0), &|_, _| true);
         for c in 0..3 {
             assert!((front[c] - sun.irradiance[c] * 0.8).abs() < 1e-12, "{front:?}");

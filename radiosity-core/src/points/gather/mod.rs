@@ -21,7 +21,7 @@ mod point;
 mod prepare;
 mod shadow;
 
-pub use point::{LeafError, SKY_ERROR_FACTOR, SKY_PROBE_SPREAD, SKY_PROBES};
+pub use point::{LeafError, SKY_ERROR_FACTOR, SKY_PATCH_ERROR_FACTOR, SKY_PATCH_PIECES, SKY_PATCH_PROBES, SKY_PROBE_SPREAD, SKY_PROBES};
 pub use prepare::{AsSolveParts, SolveParts};
 
 use super::{CalcPoint, PointIrradiance};
@@ -159,8 +159,10 @@ struct Source {
 /// the default target every point's true error is within its estimate plus the reference's 0.2%,
 /// with importance rounds (the worst point's estimate 2.2 times its error) and without. The
 /// luminaires' and the sun's direct light (one ray each) adds none: a luminaire's is exact for the
-/// point-source model. The sky's cells add their discretisation ([`PointIrradiance::sky_err`]:
-/// [`SKY_PROBES`] more rays across each cell, [`SKY_ERROR_FACTOR`]).
+/// point-source model. The sky's cells add their discretisation ([`PointIrradiance::sky_err`]):
+/// a cell with its patch of sky is probed at [`SKY_PATCH_PROBES`] and, seen in part, sampled on
+/// [`SKY_PATCH_PIECES`]² pieces ([`SKY_PATCH_ERROR_FACTOR`]); one without (made by hand) is seen
+/// along its middle ray, with [`SKY_PROBES`] more rays across it ([`SKY_ERROR_FACTOR`]).
 pub struct PointGather<'a> {
     h: &'a Hierarchy,
     caster: Option<&'a RayCaster>,
