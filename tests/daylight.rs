@@ -313,7 +313,13 @@ fn a_small_shadow_on_a_large_ground_is_exact_at_the_default_settings() {
 /// reflectance `rho`, lit by a uniform sky of 1000 lx through the opening and an isotropic
 /// 10,000 lm lamp at (1, 1, 2.5) (the shipped IES file): daylight and a luminaire in one scene.
 fn skylit_room_with_a_lamp(rho: f64, lamp: bool, sky: bool) -> String {
+    room_under_a_roof_opening(rho, lamp, sky, true)
+}
+
+/// [`skylit_room_with_a_lamp`], or with the whole ceiling open when `ceiling` is false.
+fn room_under_a_roof_opening(rho: f64, lamp: bool, sky: bool, ceiling: bool) -> String {
     let mut s = format!("units = \"photometric\"\n[[material]]\nname = \"room\"\nreflectance = {rho}\n");
+    let pieces = if ceiling { 9 } else { 5 };
     for v in [
         "[[0,0,0],[4,0,0],[4,4,0],[0,4,0]]",
         "[[0,0,0],[0,0,3],[4,0,3],[4,0,0]]",
@@ -324,7 +330,10 @@ fn skylit_room_with_a_lamp(rho: f64, lamp: bool, sky: bool) -> String {
         "[[0,2.5,3],[0,4,3],[4,4,3],[4,2.5,3]]",
         "[[0,1.5,3],[0,2.5,3],[1.5,2.5,3],[1.5,1.5,3]]",
         "[[2.5,1.5,3],[2.5,2.5,3],[4,2.5,3],[4,1.5,3]]",
-    ] {
+    ]
+    .into_iter()
+    .take(pieces)
+    {
         s += &format!("[[polygon]]\nmaterial = \"room\"\nvertices = {v}\n");
     }
     if lamp {
@@ -438,4 +447,104 @@ fn daylight_and_a_luminaire_light_one_room_in_one_solve() {
     let (grey, _) = run("grey", &skylit_room_with_a_lamp(0.5, true, true));
     assert!((grey["power_balance"].as_f64().unwrap() - 1.0).abs() < BALANCE_TOL, "{}", grey["power_balance"]);
     assert_eq!(grey["sources"].as_array().map(Vec::len), Some(2));
+}
+
+/// A point of CIE 171 5.9: name, position, normal, the table's value under the 1 × 1 m opening
+/// and under the whole open ceiling (%; NaN where left out).
+type Cie59Point = (&'static str, [f64; 3], [f64; 3], f64, f64);
+
+/// CIE 171:2006 case 5.9, sky type 5 (uniform luminance), the sky component in % of the outside
+/// horizontal illuminance: points A-F on the wall y = 0 (x = 2, z = 2.75 ... 0.25, facing +y) and
+/// G-N on the floor (x = 2, y = 0.25 ... 3.75) of a black 4 × 4 × 3 m room, under a 1 × 1 m roof
+/// opening in the middle of the ceiling, and with the whole ceiling open (the report's table, as
+/// transcribed in the project's reference notes; 4 × 4 point A is left out: the table is 3.6%
+/// high there, a known erratum, 45.12% exactly).
+///
+/// Each: the point's name, position and normal, and its value under each opening (%).
+const CIE_59_TYPE_5: [Cie59Point; 14] = [
+    ("A", [2.0, 0.0, 2.75], [0.0, 1.0, 0.0], 1.04, f64::NAN),
+    ("B", [2.0, 0.0, 2.25], [0.0, 1.0, 0.0], 2.39, 36.05),
+    ("C", [2.0, 0.0, 1.75], [0.0, 1.0, 0.0], 2.59, 28.05),
+    ("D", [2.0, 0.0, 1.25], [0.0, 1.0, 0.0], 2.20, 21.67),
+    ("E", [2.0, 0.0, 0.75], [0.0, 1.0, 0.0], 1.70, 16.73),
+    ("F", [2.0, 0.0, 0.25], [0.0, 1.0, 0.0], 1.27, 12.98),
+    ("G", [2.0, 0.25, 0.0], [0.0, 0.0, 1.0], 1.95, 26.80),
+    ("H", [2.0, 0.75, 0.0], [0.0, 0.0, 1.0], 2.52, 30.95),
+    ("I", [2.0, 1.25, 0.0], [0.0, 0.0, 1.0], 3.04, 33.99),
+    ("J", [2.0, 1.75, 0.0], [0.0, 0.0, 1.0], 3.37, 35.58),
+    ("K", [2.0, 2.25, 0.0], [0.0, 0.0, 1.0], 3.37, 35.58),
+    ("L", [2.0, 2.75, 0.0], [0.0, 0.0, 1.0], 3.04, 33.99),
+    ("M", [2.0, 3.25, 0.0], [0.0, 0.0, 1.0], 2.52, 30.95),
+    ("N", [2.0, 3.75, 0.0], [0.0, 0.0, 1.0], 1.95, 26.80),
+];
+/// The daylight factor at CIE 171 5.9's points against the report's two-decimal table: 2% (the
+/// issue's bar; the report's own tolerance is looser), plus half the table's last digit.
+const CIE_59_REL_TOL: f64 = 0.02;
+
+/// Issue 40 step 3: the daylight factor, `100 · E ÷ E_outside,horizontal`, at calculation points
+/// and on a grid, in a scene lit by a sky alone. CIE 171 5.9 for sky type 5 (both openings, at the
+/// report's points, through `points.csv`'s `df_pct`); the grid's figures in `stats.json` are those
+/// of its `df_pct` column (mean, the factor reached by half and by 95% of the points, min, max),
+/// and `--false-colour daylight-factor` draws it; a scene with a sun has no daylight factor and
+/// the false colour asks for one.
+#[test]
+fn daylight_factor_at_cie_171_5_9_points_and_on_a_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let points: String =
+        CIE_59_TYPE_5.iter().map(|(name, [x, y, z], [nx, ny, nz], _, _)| format!("{name},{x},{y},{z},{nx},{ny},{nz}\n")).collect();
+    std::fs::write(dir.path().join("pts.csv"), format!("name,x,y,z,nx,ny,nz\n{points}")).unwrap();
+    let grid = "[[grid]]\nname = \"floor\"\norigin = [0, 0, 0]\nu = [4, 0, 0]\nv = [0, 4, 0]\nspacing = 0.5\n";
+    let small = skylit_room_with_a_lamp(0.0, false, true);
+    let whole = room_under_a_roof_opening(0.0, false, true, false);
+    for (case, text) in [("1x1", format!("{small}{grid}")), ("4x4", whole)] {
+        let name = format!("df{case}");
+        std::fs::write(dir.path().join(format!("{name}.toml")), &text).unwrap();
+        let args =
+            ["solve", &format!("{name}.toml"), "--points", "pts.csv", "--quiet", "--false-colour", "daylight-factor", "--out", &name];
+        let out = run_cli(dir.path(), &args);
+        assert!(out.status.success(), "{case}: {}", String::from_utf8_lossy(&out.stderr));
+        let (header, rows) = csv(&dir.path().join(&name).join("points.csv"));
+        let (df, df_err) = (column(&header, "df_pct"), column(&header, "df_err_pct"));
+        for ((label, _, _, small_table, whole_table), row) in CIE_59_TYPE_5.iter().zip(&rows) {
+            let table = if case == "1x1" { *small_table } else { *whole_table };
+            if table.is_nan() {
+                continue;
+            }
+            let (got, err): (f64, f64) = (row[df].parse().unwrap(), row[df_err].parse().unwrap());
+            eprintln!("CIE 5.9 {case} {label}: DF {got:.3}% ± {err:.3} against {table}");
+            assert!((got - table).abs() <= CIE_59_REL_TOL * table + 0.005, "{case} {label}: {got}% against the report's {table}%");
+        }
+        assert!(dir.path().join(&name).join("falsecolor.png").exists());
+    }
+    // The grid's figures are its column's.
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("df1x1/stats.json")).unwrap()).unwrap();
+    let figures = &stats["grids"]["floor"]["daylight_factor"];
+    let (header, rows) = csv(&dir.path().join("df1x1/grid_floor.csv"));
+    let mut df: Vec<f64> = rows.iter().map(|r| r[column(&header, "df_pct")].parse().unwrap()).collect();
+    df.sort_by(|a, b| b.total_cmp(a));
+    let n = df.len();
+    assert_eq!(n, 64);
+    let want = [
+        ("mean", df.iter().sum::<f64>() / n as f64),
+        ("median", df[n / 2 - 1]),
+        ("over_95", df[(0.95 * n as f64).ceil() as usize - 1]),
+        ("min", df[n - 1]),
+        ("max", df[0]),
+    ];
+    for (key, value) in want {
+        let got = figures[key].as_f64().unwrap_or_else(|| panic!("no {key} in {figures}"));
+        assert!((got - value).abs() <= 1e-9 * value.abs().max(1.0), "{key}: {got} against {value} from the column");
+    }
+    assert!((figures["outside"].as_f64().unwrap() - 1000.0).abs() < 1e-6, "{figures}");
+    assert!(dir.path().join("df1x1/grid_floor_df.svg").exists());
+    // With a sun there is no daylight factor: no column, no figures, and the false colour says why.
+    let sunny = format!("{small}{grid}[sun]\ndirection = [0.3, 0.2, -0.9]\ndirect_normal = 5000\n");
+    std::fs::write(dir.path().join("sunny.toml"), &sunny).unwrap();
+    let out = run_cli(dir.path(), &["solve", "sunny.toml", "--quiet", "--no-image", "--out", "sunny"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (header, _) = csv(&dir.path().join("sunny/grid_floor.csv"));
+    assert!(!header.iter().any(|h| h.starts_with("df_")), "{header:?}");
+    let out = run_cli(dir.path(), &["solve", "sunny.toml", "--quiet", "--false-colour", "daylight-factor", "--out", "sunny2"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("not lit by a sky alone") && err.trim().lines().count() == 1, "{err}");
 }

@@ -83,7 +83,7 @@ fn floor_strip_through_the_cie_points_has_the_figures_computed_by_hand() {
     assert!((s.min_over_max - 61.424 / 105.778).abs() <= 1e-5, "{}", s.min_over_max);
     // The CSV: header, then one row per point in grid order, positions and normal exact.
     let mut csv = Vec::new();
-    write_grid_csv(&mut csv, &grid, &results, Units::Photometric).unwrap();
+    write_grid_csv(&mut csv, &grid, &results, Units::Photometric, None).unwrap();
     let csv = String::from_utf8(csv).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 9);
@@ -95,7 +95,7 @@ fn floor_strip_through_the_cie_points_has_the_figures_computed_by_hand() {
     assert!(rows[4].split(',').nth(12) == Some("lm/m2"), "{}", rows[4]);
     assert!(fields.iter().all(|f| (f - 105.778).abs() <= REFERENCE_ROUNDING), "{}", rows[4]);
     let mut csv = Vec::new();
-    write_grid_csv(&mut csv, &grid, &results, Units::Radiometric).unwrap();
+    write_grid_csv(&mut csv, &grid, &results, Units::Radiometric, None).unwrap();
     assert!(String::from_utf8(csv).unwrap().starts_with("name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic,units,h_err\n"));
 }
 

@@ -15,8 +15,9 @@ pub struct PictureArgs {
     #[arg(long, value_name = "OPTIONS|FILE.vf", allow_hyphen_values = true)]
     pub view: Option<String>,
     /// What falsecolor.png (written beside image.png) shows: `irradiance` (the light falling on
-    /// each surface), `radiosity` (the light leaving it), or `none` (no falsecolor.png). Plain
-    /// scenes only.
+    /// each surface), `radiosity` (the light leaving it), `daylight-factor` (the irradiance as a
+    /// share of the sky's on an open horizontal plane, %: a scene lit by a sky alone), or `none`
+    /// (no falsecolor.png). Plain scenes only.
     #[arg(long = "false-colour", value_enum, default_value_t = FalseColour::Irradiance)]
     pub false_colour: FalseColour,
     /// Scale of falsecolor.png: `linear` (from 0) or `log` (3 decades below the top).
@@ -35,6 +36,8 @@ pub enum FalseColour {
     Irradiance,
     /// Radiosity.
     Radiosity,
+    /// The daylight factor (%).
+    DaylightFactor,
     /// No falsecolor.png.
     None,
 }
@@ -63,6 +66,7 @@ impl PictureArgs {
         let quantity = match self.false_colour {
             FalseColour::Irradiance => Quantity::Irradiance,
             FalseColour::Radiosity => Quantity::Radiosity,
+            FalseColour::DaylightFactor => Quantity::DaylightFactor,
             FalseColour::None => return Ok((view, None)),
         };
         let scale = match self.scale {

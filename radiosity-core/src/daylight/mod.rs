@@ -28,12 +28,14 @@
 //! vectors of cells under either (`quadrature.rs`);
 //! [`DistantLight`], the distant sources seen from a point with a shadow ray (`distant.rs`); which
 //! one-sided faces get a back and which backs are open (`backs.rs`); the power that arrives, leaves
-//! the scene or is lost at open backs, and the balance of a solve (`balance.rs`).
+//! the scene or is lost at open backs, and the balance of a solve (`balance.rs`); the daylight
+//! factor's reference, the sky's light on an open horizontal plane (`factor.rs`).
 
 mod backs;
 mod balance;
 mod cie_general;
 mod distant;
+mod factor;
 mod perez;
 mod quadrature;
 mod sky;
@@ -46,6 +48,7 @@ pub use backs::{open_backs, two_sided_where_backs_see_light};
 pub use balance::{Escapes, Leaving, OutsideLinks, balance_gap, outside_links, power_incident, power_incident_on_backs, power_leaving};
 pub use cie_general::{CIE_GENERAL_TYPES, CieSky};
 pub use distant::{DistantLight, FAR_REL};
+pub use factor::{outside_horizontal, sky_alone_horizontal};
 pub use perez::{
     PEREZ_BRIGHTNESS_RANGE, PEREZ_CLEARNESS_BINS, PEREZ_CLEARNESS_RANGE, PEREZ_MIN_BRIGHTNESS_MID_BINS, PerezSky, SOLAR_CONSTANT,
     perez_parameters,

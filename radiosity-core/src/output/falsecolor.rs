@@ -66,6 +66,9 @@ pub enum Quantity {
     Irradiance,
     /// Radiosity: the light leaving a surface, W/m².
     Radiosity,
+    /// The daylight factor: the irradiance as a share of the sky's on an open horizontal plane, %
+    /// (the caller sets [`FalseColourConfig::factor`] to `100 ÷ E_outside` and the unit to `%`).
+    DaylightFactor,
 }
 
 impl Quantity {
@@ -75,6 +78,7 @@ impl Quantity {
         match self {
             Quantity::Irradiance => "irradiance",
             Quantity::Radiosity => "radiosity",
+            Quantity::DaylightFactor => "daylight factor",
         }
     }
 }
@@ -228,7 +232,7 @@ pub fn format_label(v: f64) -> String {
 /// The per-element values a quantity shows.
 fn element_values(solution: &Solution, quantity: Quantity) -> &[[f64; 3]] {
     match quantity {
-        Quantity::Irradiance => &solution.irradiance,
+        Quantity::Irradiance | Quantity::DaylightFactor => &solution.irradiance,
         Quantity::Radiosity => &solution.radiosity,
     }
 }

@@ -21,9 +21,16 @@ const PLOT_HEIGHT_RANGE: (f64, f64) = (240.0, 900.0);
 const HULL_TOL_CELLS: f64 = 1e-9;
 
 /// Writes `grid_<name>.csv`: the grid's points in its order, in the columns of `points.csv`
-/// ([`super::write_points_csv_in`]: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units,h_err[,e_err]`).
-pub fn write_grid_csv(w: &mut impl Write, grid: &Grid, results: &[PointIrradiance], units: Units) -> std::io::Result<()> {
-    super::write_points_csv_in(w, &grid.points, results, units)
+/// ([`super::write_points_csv_with`]: `name,x,y,z,nx,ny,nz,h_r,h_g,h_b,h_photopic[,e_lx],units,h_err[,e_err]`,
+/// then `df_pct,df_err_pct` with `outside`, the daylight factor's reference).
+pub fn write_grid_csv(
+    w: &mut impl Write,
+    grid: &Grid,
+    results: &[PointIrradiance],
+    units: Units,
+    outside: Option<f64>,
+) -> std::io::Result<()> {
+    super::write_points_csv_with(w, &grid.points, results, units, outside)
 }
 
 /// Contour levels for values between `min` and `max`: the multiples of a 1-2-2.5-5 step strictly
@@ -66,12 +73,35 @@ fn format_level(value: f64, step: f64) -> String {
 /// their values, and the figures in a caption. Axes are `s` along `u` and `t` along `v` from the
 /// grid's origin (scene units). `values` are the points' photopic values, in the grid's order.
 pub fn grid_svg(grid: &Grid, values: &[f64], summary: &GridSummary, units: Units) -> std::io::Result<String> {
+    let unit = photopic_unit(units);
+    let caption = format!("grid {}: {} ({unit}), {} × {} points", grid.spec.name, photopic_column(units), grid.n_u, grid.n_v);
+    contour_svg(grid, values, &caption, &|step| {
+        format!(
+            "Eavg {:.4} {unit};  Emin {:.4} {unit};  Emax {:.4} {unit};  U0 = Emin/Eavg {:.3};  Emin/Emax {:.3};  contours every {step} {unit}",
+            summary.e_avg, summary.e_min, summary.e_max, summary.u0, summary.min_over_max,
+        )
+    })
+}
+
+/// The daylight-factor plot of a grid as SVG text, like [`grid_svg`]: `df` are the points'
+/// daylight factors (%), `figures` theirs ([`GridSummary::with_daylight_factor`]).
+pub fn grid_df_svg(grid: &Grid, df: &[f64], figures: &crate::points::grid::DaylightFactorFigures) -> std::io::Result<String> {
+    let caption = format!("grid {}: daylight factor (%), {} × {} points", grid.spec.name, grid.n_u, grid.n_v);
+    contour_svg(grid, df, &caption, &|step| {
+        format!(
+            "DF mean {:.3}%;  reached by half the points {:.3}%, by 95% {:.3}%;  min {:.3}%;  max {:.3}%;  contours every {step}%",
+            figures.mean, figures.median, figures.over_95, figures.min, figures.max,
+        )
+    })
+}
+
+/// A grid's contour plot of `values`: `caption` above, `footer(contour step)` below.
+fn contour_svg(grid: &Grid, values: &[f64], caption: &str, footer_text: &dyn Fn(String) -> String) -> std::io::Result<String> {
     let (lu, lv) = (glam::DVec3::from_array(grid.spec.u).length(), glam::DVec3::from_array(grid.spec.v).length());
     let (du, dv) = (lu / grid.n_u as f64, lv / grid.n_v as f64);
     let plot_w = f64::from(SVG_WIDTH) - 90.0;
     let plot_h = (plot_w * lv / lu).clamp(PLOT_HEIGHT_RANGE.0, PLOT_HEIGHT_RANGE.1);
     let height = (plot_h + 130.0) as u32;
-    let unit = photopic_unit(units);
     let min = values.iter().copied().fold(f64::INFINITY, f64::min);
     let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let levels = contour_levels(min, max);
@@ -96,10 +126,7 @@ pub fn grid_svg(grid: &Grid, values: &[f64], summary: &GridSummary, units: Units
         root.fill(&WHITE).map_err(e)?;
         let (plot, footer) = root.split_vertically(height - 50);
         let mut chart = ChartBuilder::on(&plot)
-            .caption(
-                format!("grid {}: {} ({unit}), {} × {} points", grid.spec.name, photopic_column(units), grid.n_u, grid.n_v),
-                ("sans-serif", 16),
-            )
+            .caption(caption, ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(36)
             .y_label_area_size(48)
@@ -130,15 +157,7 @@ pub fn grid_svg(grid: &Grid, values: &[f64], summary: &GridSummary, units: Units
                 }
             }
         }
-        let figures = format!(
-            "Eavg {:.4} {unit};  Emin {:.4} {unit};  Emax {:.4} {unit};  U0 = Emin/Eavg {:.3};  Emin/Emax {:.3};  contours every {} {unit}",
-            summary.e_avg,
-            summary.e_min,
-            summary.e_max,
-            summary.u0,
-            summary.min_over_max,
-            if step > 0.0 { format_level(step, step) } else { "-".into() }
-        );
+        let figures = footer_text(if step > 0.0 { format_level(step, step) } else { "-".into() });
         footer.draw(&Text::new(figures, (12, 18), ("sans-serif", 13).into_font())).map_err(e)?;
         root.present().map_err(e)?;
     }

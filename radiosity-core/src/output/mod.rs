@@ -26,9 +26,9 @@ pub use falsecolor::{
 };
 pub use glb::{GLB_RADIOSITY_ATTRIBUTE, GlbLayout, write_glb};
 pub(crate) use glb::{push_f32s, push_fan};
-pub use grid::{SVG_WIDTH, TARGET_CONTOUR_LEVELS, contour_levels, grid_svg, write_grid_csv};
+pub use grid::{SVG_WIDTH, TARGET_CONTOUR_LEVELS, contour_levels, grid_df_svg, grid_svg, write_grid_csv};
 pub use ply::write_ply;
-pub use points::{write_points_csv, write_points_csv_in};
+pub use points::{write_points_csv, write_points_csv_in, write_points_csv_with};
 pub use render::{Frame, OUTSIDE_PREFERENCE, RenderConfig, ToneMap, default_view, frame, mean_brightness, render, render_frame, write_png};
 pub use smooth::CornerValues;
 pub use stats::{BandPower, LOST_AT_BACKS_WARN_REL, Stats, StatsTimes, channel_powers, peak_rss_bytes, power_balance};

@@ -111,6 +111,39 @@ pub struct GridSummary {
     /// The largest estimated error of a point's value, same unit (`None`: not estimated).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub e_err_max: Option<f64>,
+    /// The grid's daylight factors, in a scene lit by a sky alone (see
+    /// [`GridSummary::with_daylight_factor`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub daylight_factor: Option<DaylightFactorFigures>,
+}
+
+/// A grid's daylight factors, `DF = 100 · E ÷ E_outside` in %, `E_outside` the illuminance the sky
+/// gives an unobstructed horizontal plane ([`crate::daylight::sky_alone_horizontal`]). EN 17037
+/// asks for a target factor over half of a room's reference plane and a minimum one over 95% of
+/// it: `median` and `over_95` are those figures of the grid.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DaylightFactorFigures {
+    /// `E_outside` (the photopic value, in the grid's unit).
+    pub outside: f64,
+    /// The mean factor (%).
+    pub mean: f64,
+    /// The factor reached at half of the points or more (%).
+    pub median: f64,
+    /// The factor reached at 95% of the points or more (%).
+    pub over_95: f64,
+    /// The smallest (%).
+    pub min: f64,
+    /// The largest (%).
+    pub max: f64,
+    /// The largest estimated error of a point's factor (%; `None`: not estimated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub err_max: Option<f64>,
+}
+
+/// The largest value reached by at least `share` of `values` (sorted from the largest down).
+fn reached_by(sorted_down: &[f64], share: f64) -> f64 {
+    let k = ((share * sorted_down.len() as f64).ceil() as usize).clamp(1, sorted_down.len());
+    sorted_down[k - 1]
 }
 
 /// The name of the photopic column of `grid_<name>.csv` (and of the figures): `e_lx` in
@@ -152,6 +185,7 @@ impl GridSummary {
             u0: ratio(e_min, e_avg),
             min_over_max: ratio(e_min, e_max),
             e_err_max: None,
+            daylight_factor: None,
         })
     }
 
@@ -160,6 +194,30 @@ impl GridSummary {
     #[must_use]
     pub fn with_errors(mut self, errors: &[f64]) -> GridSummary {
         self.e_err_max = errors.iter().all(|e| e.is_finite()).then(|| errors.iter().copied().fold(0.0, f64::max));
+        self
+    }
+
+    /// The same figures with the daylight factors of `values` (the points' photopic values, as
+    /// given to [`GridSummary::of`]) relative to `outside` ([`DaylightFactorFigures`]), their
+    /// largest error from `errors` (none when one is not finite); unchanged when `outside` is not
+    /// positive or `values` is empty.
+    #[must_use]
+    pub fn with_daylight_factor(mut self, values: &[f64], errors: &[f64], outside: f64) -> GridSummary {
+        if !(outside.is_finite() && outside > 0.0) || values.is_empty() {
+            return self;
+        }
+        let df: Vec<f64> = values.iter().map(|v| 100.0 * v / outside).collect();
+        let mut sorted = df.clone();
+        sorted.sort_by(|a, b| b.total_cmp(a));
+        self.daylight_factor = Some(DaylightFactorFigures {
+            outside,
+            mean: df.iter().sum::<f64>() / df.len() as f64,
+            median: reached_by(&sorted, 0.5),
+            over_95: reached_by(&sorted, 0.95),
+            min: sorted[sorted.len() - 1],
+            max: sorted[0],
+            err_max: errors.iter().all(|e| e.is_finite()).then(|| 100.0 * errors.iter().copied().fold(0.0, f64::max) / outside),
+        });
         self
     }
 }

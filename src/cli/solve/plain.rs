@@ -44,6 +44,23 @@ pub(super) fn solve(
     reporter.phase("loading scene");
     let Loaded { scene, bands, points, grids } = load(args, lit)?;
     let load = t0.elapsed().as_secs_f64();
+    // The daylight factor's reference: the sky's light on an open horizontal plane, in a scene lit
+    // by a sky alone (RGB: the photopic value of named bands means nothing).
+    let outside = radiosity::daylight::sky_alone_horizontal(&scene)
+        .filter(|_| bands.as_ref().is_none_or(|b| !b.declared))
+        .map(radiosity::points::photopic);
+    let false_colour = match false_colour {
+        Some(fc) if fc.quantity == output::Quantity::DaylightFactor => {
+            let outside = outside.with_context(|| {
+                format!(
+                    "--false-colour daylight-factor: {} is not lit by a sky alone (a daylight factor needs a [sky] with no sun, luminaires or emitting materials, and no named bands)",
+                    scene.name
+                )
+            })?;
+            Some(FalseColourConfig { factor: 100.0 / outside, unit: "%", ..fc })
+        }
+        other => other.map(|fc| photometric_unit(fc, &scene)),
+    };
     let (params, oracle, config) = oracle_and_config(args)?;
     // The target applies to the calculation points and every grid as well (importance rounds).
     let point_sets: Vec<&[CalcPoint]> = points.iter().map(Vec::as_slice).chain(grids.iter().map(|g| g.points.as_slice())).collect();
@@ -70,7 +87,6 @@ pub(super) fn solve(
             *v = [v[0]; 3];
         }
     }
-    let false_colour = false_colour.map(|fc| photometric_unit(fc, &scene));
     let out_config = OutputConfig {
         image: !args.no_image,
         render: output::RenderConfig { width: args.size, height: args.size, ..Default::default() },
@@ -83,14 +99,14 @@ pub(super) fn solve(
     }
     if let Some((points, (results, seconds))) = points.as_ref().zip(gathered.points.as_ref()) {
         let path = args.out.join("points.csv");
-        output::atomic::write_file(&path, |w| output::write_points_csv_in(w, points, results, scene.units))
+        output::atomic::write_file(&path, |w| output::write_points_csv_with(w, points, results, scene.units, outside))
             .with_context(|| format!("{}: cannot write", path.display()))?;
         stats.points = Some(points.len());
         stats.point_rays = Some(results.iter().map(|r| r.rays).sum());
         stats.time_s.points = Some(*seconds);
     }
     if !grids.is_empty() {
-        stats.grids = Some(write_grids(&args.out, &grids, &gathered.grids, scene.units)?);
+        stats.grids = Some(write_grids(&args.out, &grids, &gathered.grids, scene.units, outside)?);
         stats.time_s.grids = Some(gathered.grid_seconds);
     }
     stats.solve_warnings.extend(target_warnings(&config, &solved, &gathered, &grids));
@@ -267,6 +283,7 @@ fn photometric_unit(mut fc: FalseColourConfig, scene: &Scene) -> FalseColourConf
         fc.unit = match fc.quantity {
             output::Quantity::Irradiance => "lx",
             output::Quantity::Radiosity => "lm/m²",
+            output::Quantity::DaylightFactor => fc.unit,
         };
     }
     fc

@@ -119,6 +119,14 @@ pub(super) fn print_summary(s: &Stats, out: &std::path::Path, pictures: &str) {
             g.points, g.e_avg, g.e_min, g.e_max, g.u0, g.min_over_max
         );
         grid_files.push_str(&format!(",grid_{name}.csv,grid_{name}.svg"));
+        if let Some(df) = &g.daylight_factor {
+            let err = df.err_max.map_or_else(String::new, |e| format!(", estimated error at most {e:.3}%"));
+            println!(
+                "grid {name}: daylight factor mean {:.3}%, reached by half the points {:.3}%, by 95% {:.3}%, min {:.3}%, max {:.3}% (of {:.4e} {unit} outside){err}",
+                df.mean, df.median, df.over_95, df.min, df.max, df.outside
+            );
+            grid_files.push_str(&format!(",grid_{name}_df.svg"));
+        }
     }
     let points = if s.points.is_some() { ",points.csv" } else { "" };
     println!("wrote {}/{{{pictures}solution.ply,solution.glb,patches.csv,groups.csv,stats.json{points}{grid_files}}}", out.display());

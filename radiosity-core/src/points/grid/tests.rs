@@ -98,7 +98,19 @@ fn grid_specs_read_from_toml_deny_unknown_fields() {
 #[test]
 fn summary_of_known_values() {
     let s = GridSummary::of(&[100.0, 200.0, 300.0, 400.0]).unwrap();
-    assert_eq!(s, GridSummary { points: 4, e_avg: 250.0, e_min: 100.0, e_max: 400.0, u0: 0.4, min_over_max: 0.25, e_err_max: None });
+    assert_eq!(
+        s,
+        GridSummary {
+            points: 4,
+            e_avg: 250.0,
+            e_min: 100.0,
+            e_max: 400.0,
+            u0: 0.4,
+            min_over_max: 0.25,
+            e_err_max: None,
+            daylight_factor: None
+        }
+    );
     assert_eq!(s.with_errors(&[1.0, 3.0, 2.0, 0.5]).e_err_max, Some(3.0));
     assert_eq!(s.with_errors(&[1.0, f64::NAN]).e_err_max, None);
     let dark = GridSummary::of(&[0.0, 0.0]).unwrap();
@@ -107,6 +119,24 @@ fn summary_of_known_values() {
     assert_eq!(GridSummary::of(&[1.0, f64::NAN]), None);
     assert_eq!(photopic_column(Units::Photometric), "e_lx");
     assert_eq!(photopic_column(Units::Radiometric), "h_photopic");
+}
+
+/// Daylight factors by hand: 20 points of 10, 20, ..., 200 lx under an outside 10,000 lx are
+/// 0.1, 0.2, ..., 2.0%; half of them reach 1.1% (the 10th largest), 95% reach 0.2% (the 19th).
+#[test]
+fn daylight_factor_figures_by_hand() {
+    let values: Vec<f64> = (1..=20).rev().map(|k| 10.0 * f64::from(k)).collect();
+    let errors = vec![1.0; 20];
+    let s = GridSummary::of(&values).unwrap().with_daylight_factor(&values, &errors, 10_000.0);
+    let df = s.daylight_factor.expect("figures");
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-12;
+    assert!(near(df.median, 1.1) && near(df.over_95, 0.2) && near(df.min, 0.1) && near(df.max, 2.0), "{df:?}");
+    assert!(near(df.mean, 1.05) && near(df.outside, 10_000.0) && df.err_max.is_some_and(|e| near(e, 0.01)), "{df:?}");
+    // Three points: half is two of them, 95% all three.
+    let s = GridSummary::of(&[3.0, 1.0, 2.0]).unwrap().with_daylight_factor(&[3.0, 1.0, 2.0], &[f64::NAN; 3], 100.0);
+    let df = s.daylight_factor.unwrap();
+    assert!(near(df.median, 2.0) && near(df.over_95, 1.0) && df.err_max.is_none(), "{df:?}");
+    assert_eq!(GridSummary::of(&[1.0]).unwrap().with_daylight_factor(&[1.0], &[0.0], 0.0).daylight_factor, None);
 }
 
 #[test]
