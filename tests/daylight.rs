@@ -548,3 +548,28 @@ fn daylight_factor_at_cie_171_5_9_points_and_on_a_grid() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("not lit by a sky alone") && err.trim().lines().count() == 1, "{err}");
 }
+
+/// The worked example of the docs (`examples/daylight/sidelit_room.toml`, a side-lit room under
+/// the CIE overcast sky) solves from the command the docs give: its work plane's daylight
+/// factors are written, the balance of the open room closes, and the factors fall from the window
+/// to the back wall.
+#[test]
+fn the_side_lit_room_example_gives_its_daylight_factors() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/daylight/sidelit_room.toml");
+    let out = run_cli(dir.path(), &["solve", scene.to_str().unwrap(), "--quiet", "--false-colour", "daylight-factor", "--out", "out"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/stats.json")).unwrap()).unwrap();
+    assert!((stats["power_balance"].as_f64().unwrap() - 1.0).abs() < BALANCE_TOL, "{}", stats["power_balance"]);
+    let df = &stats["grids"]["work"]["daylight_factor"];
+    assert!((df["outside"].as_f64().unwrap() - 10_000.0).abs() < 1e-6, "{df}");
+    let (header, rows) = csv(&dir.path().join("out/grid_work.csv"));
+    let (x, d) = (column(&header, "x"), column(&header, "df_pct"));
+    let mean_at = |lo: f64, hi: f64| {
+        let v: Vec<f64> = rows.iter().filter(|r| (lo..hi).contains(&r[x].parse::<f64>().unwrap())).map(|r| r[d].parse().unwrap()).collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let (front, back) = (mean_at(0.0, 1.5), mean_at(4.5, 6.0));
+    assert!(front > 2.0 * back && back > 0.5, "daylight factor by the window {front}%, at the back {back}%");
+    assert!(dir.path().join("out/falsecolor.png").exists() && dir.path().join("out/grid_work_df.svg").exists());
+}
