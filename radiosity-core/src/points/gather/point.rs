@@ -151,6 +151,7 @@ impl PointGather<'_> {
         let cells = distant.iter().filter(|s| !s.sharp).count();
         let spread = SKY_PROBE_SPREAD * (2.0 / cells.max(1) as f64).sqrt();
         let (mut sky_off, mut patch_err) = ([0.0; 3], [0.0; 3]);
+        let mut partial: Vec<&SkyPatch> = Vec::new();
         for s in distant {
             if (0..sides.len).any(|k| sides.normals[k].dot(s.toward) >= 0.0) {
                 continue;
@@ -170,12 +171,7 @@ impl PointGather<'_> {
                     continue;
                 }
                 if probed.seen < probed.probes {
-                    let sampled = sample_patch(patch, caster, origin, far, n, horizon);
-                    out.rays += sampled.rays;
-                    for c in 0..3 {
-                        out.h[c] += sampled.fine[c];
-                        patch_err[c] += SKY_PATCH_ERROR_FACTOR * (sampled.fine[c] - sampled.coarse[c]).abs();
-                    }
+                    partial.push(patch);
                     continue;
                 }
             } else if let Some(caster) = self.caster {
@@ -208,6 +204,20 @@ impl PointGather<'_> {
                 out.h[c] += e[c];
             }
         }
+        // The cells seen in part, sampled on as many pieces as the point's budget of rays allows
+        // them: a few cells carrying all the light (an opening) finely, many (a canopy) coarser.
+        if let (Some(caster), false) = (self.caster, partial.is_empty()) {
+            let horizon = &sides.normals[..sides.len];
+            let k = pieces_for(partial.len());
+            for patch in partial {
+                let sampled = sample_patch(patch, caster, origin, far, n, horizon, k);
+                out.rays += sampled.rays;
+                for c in 0..3 {
+                    out.h[c] += sampled.fine[c];
+                    patch_err[c] += SKY_PATCH_ERROR_FACTOR * (sampled.fine[c] - sampled.coarse[c]).abs();
+                }
+            }
+        }
         for c in 0..3 {
             out.sky_err[c] = SKY_ERROR_FACTOR * sky_off[c] + patch_err[c];
             out.h_err[c] += out.sky_err[c];
@@ -217,8 +227,19 @@ impl PointGather<'_> {
 }
 
 /// A sky cell seen in part from a calculation point (or reaching below its horizon) is sampled
-/// on this many pieces of equal solid angle across and along ([`SkyPatch::pieces`]), one ray each.
+/// on at most this many pieces of equal solid angle across and along, one ray each: as many as
+/// [`SKY_PATCH_BUDGET`] allows the point's cells seen in part, at least [`SKY_PATCH_MIN_PIECES`].
 pub const SKY_PATCH_PIECES: usize = 16;
+/// Rays a calculation point may spend on sampling the sky cells it sees in part (before their
+/// edge pieces are sampled again): up to 16 such cells get [`SKY_PATCH_PIECES`]² pieces each.
+pub const SKY_PATCH_BUDGET: usize = 4096;
+/// The fewest pieces across and along a cell seen in part is sampled on.
+pub const SKY_PATCH_MIN_PIECES: usize = 4;
+
+/// Pieces across and along for each of `cells` cells seen in part ([`SKY_PATCH_BUDGET`]).
+fn pieces_for(cells: usize) -> usize {
+    ((SKY_PATCH_BUDGET as f64 / cells.max(1) as f64).sqrt() as usize).clamp(SKY_PATCH_MIN_PIECES, SKY_PATCH_PIECES)
+}
 
 /// Where a sky cell's patch is probed from a calculation point, as fractions of its way in cos θ
 /// ([`SkyPatch::toward`]): its edges (just inside) and its middle; along the azimuth as many
@@ -282,8 +303,7 @@ struct SampledPatch {
 /// each piece above the point's horizon and seen by its ray gives the patch's radiance times its
 /// solid angle times its cosine; pieces whose verdict differs from a neighbour's are sampled
 /// again on sub-pieces.
-fn sample_patch(patch: &SkyPatch, caster: &RayCaster, origin: DVec3, far: f64, n: DVec3, sides: &[DVec3]) -> SampledPatch {
-    let k = SKY_PATCH_PIECES;
+fn sample_patch(patch: &SkyPatch, caster: &RayCaster, origin: DVec3, far: f64, n: DVec3, sides: &[DVec3], k: usize) -> SampledPatch {
     let mut rays = 0;
     // A direction's weight (its cosine on the receiver, 0 below the point's horizon) and whether
     // its ray sees the sky.
@@ -300,11 +320,11 @@ fn sample_patch(patch: &SkyPatch, caster: &RayCaster, origin: DVec3, far: f64, n
     let verdicts: Vec<(f64, bool)> = (0..k * k).map(|m| look(patch.toward(middle(m / k), middle(m % k)))).collect();
     let seen = |m: usize| verdicts[m].1;
     let mut fine: f64 = verdicts.iter().filter(|v| v.1).map(|v| v.0 * omega).sum();
-    let coarse: f64 = (0..k * k)
-        .filter(|&m| (m / k).is_multiple_of(2) && (m % k).is_multiple_of(2) && seen(m))
-        .map(|m| 4.0 * verdicts[m].0 * omega)
-        .sum();
-    let sub = SKY_EDGE_PIECES;
+    let every_other = |m: usize| (m / k).is_multiple_of(2) && (m % k).is_multiple_of(2);
+    let stands_for = (k * k) as f64 / (0..k * k).filter(|&m| every_other(m)).count() as f64;
+    let coarse: f64 = (0..k * k).filter(|&m| every_other(m) && seen(m)).map(|m| stands_for * verdicts[m].0 * omega).sum();
+    // Sub-pieces in proportion: a coarsely sampled cell's edge pieces are sampled again coarsely.
+    let sub = (SKY_EDGE_PIECES * k).div_ceil(SKY_PATCH_PIECES).max(2);
     for m in 0..k * k {
         let (i, j) = (m / k, m % k);
         let neighbours = [(i > 0).then(|| m - k), (i + 1 < k).then(|| m + k), (j > 0).then(|| m - 1), (j + 1 < k).then(|| m + 1)];
