@@ -21,7 +21,10 @@ mod point;
 mod prepare;
 mod shadow;
 
-pub use point::{LeafError, SKY_ERROR_FACTOR, SKY_PATCH_ERROR_FACTOR, SKY_PATCH_PIECES, SKY_PATCH_PROBES, SKY_PROBE_SPREAD, SKY_PROBES};
+pub use point::{
+    LeafError, SKY_EDGE_PIECES, SKY_ERROR_FACTOR, SKY_PATCH_BUDGET, SKY_PATCH_ERROR_FACTOR, SKY_PATCH_MIN_PIECES, SKY_PATCH_PIECES,
+    SKY_PATCH_PROBES, SKY_PROBE_SPREAD, SKY_PROBES,
+};
 pub use prepare::{AsSolveParts, SolveParts};
 
 use super::{CalcPoint, PointIrradiance};

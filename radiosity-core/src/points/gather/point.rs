@@ -291,7 +291,8 @@ pub const SKY_PATCH_ERROR_FACTOR: f64 = 0.33;
 
 /// What a calculation point receives from a sky cell's patch, sampled ray by ray.
 struct SampledPatch {
-    /// On [`SKY_PATCH_PIECES`]² pieces, the pieces along an edge on [`SKY_EDGE_PIECES`]² each.
+    /// On the pieces the budget gives ([`SKY_PATCH_PIECES`]² at most), the pieces along an edge
+    /// sampled again ([`SKY_EDGE_PIECES`]² sub-pieces each at most).
     fine: [f64; 3],
     /// On every other piece along both directions, each standing for four.
     coarse: [f64; 3],
