@@ -58,11 +58,17 @@ impl SkyPatch {
         -(east * (sin * sp) + north * (sin * cp) + up * mu).normalize()
     }
 
+    /// The solid angle of each of the patch's `k × k` pieces ([`SkyPatch::pieces`]).
+    #[must_use]
+    pub fn piece_solid_angle(&self, k: usize) -> f64 {
+        (self.mu[1] - self.mu[0]) * self.phi[1] / (k * k) as f64
+    }
+
     /// The patch split into `k × k` pieces of equal solid angle (in cos θ and azimuth): the
     /// direction light travels through each piece's middle and the piece's solid angle, row by
     /// row (`i * k + j`, `i` along cos θ).
     pub fn pieces(&self, k: usize) -> impl Iterator<Item = (DVec3, f64)> + '_ {
-        let omega = (self.mu[1] - self.mu[0]) * self.phi[1] / (k * k) as f64;
+        let omega = self.piece_solid_angle(k);
         let middle = move |i: usize| (i as f64 + 0.5) / k as f64;
         (0..k * k).map(move |n| (self.toward(middle(n / k), middle(n % k)), omega))
     }

@@ -316,9 +316,8 @@ fn sample_patch(patch: &SkyPatch, caster: &RayCaster, origin: DVec3, far: f64, n
         rays += 1;
         (cos, caster.segment_clear(origin, origin - toward * far, NONE, NONE))
     };
-    let omega = (patch.mu[1] - patch.mu[0]) * patch.phi[1] / (k * k) as f64;
-    let middle = |i: usize| (i as f64 + 0.5) / k as f64;
-    let verdicts: Vec<(f64, bool)> = (0..k * k).map(|m| look(patch.toward(middle(m / k), middle(m % k)))).collect();
+    let omega = patch.piece_solid_angle(k);
+    let verdicts: Vec<(f64, bool)> = patch.pieces(k).map(|(toward, _)| look(toward)).collect();
     let seen = |m: usize| verdicts[m].1;
     let mut fine: f64 = verdicts.iter().filter(|v| v.1).map(|v| v.0 * omega).sum();
     let every_other = |m: usize| (m / k).is_multiple_of(2) && (m % k).is_multiple_of(2);
